@@ -1,0 +1,24 @@
+#pragma once
+// Shared plumbing of the fluoroct command-line tool: how commands register and how errors are reported.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <string>
+
+namespace fct::cli {
+
+/// Exit status of every failed command.
+constexpr int kExitError = 2;
+
+/// The action a parsed subcommand runs; returns the process exit status.
+using CommandAction = std::function<int()>;
+
+/// Prints "error: <message>" as one line on stderr and returns kExitError.
+int reportError(const std::string& message);
+
+// Each command file provides a register function: it adds its subcommand to `app` and, when the subcommand is
+// chosen, stores its action in `action` (run after parsing).
+
+
+}  // namespace fct::cli

@@ -1,0 +1,36 @@
+#pragma once
+// Helpers shared by the test programs: where the real data lives, scratch folders, running the CLI.
+
+#include <filesystem>
+#include <string>
+
+namespace fct::test {
+
+/// The shared real-data folder: $FLUOROCT_DATA_DIR if set, else ../shared/data beside the source tree.
+std::filesystem::path dataDir();
+/// True if dataDir()/relative exists.
+bool hasData(const std::string& relative);
+/// A fresh, empty scratch folder unique to the running test (removed and recreated on each call).
+std::filesystem::path scratchDir();
+/// Path of the built `fluoroct` command-line program.
+std::filesystem::path cliPath();
+
+/// Output of a finished process.
+struct ProcessResult {
+  int exitCode = -1;  ///< exit status, or -1 if it did not exit normally (signal)
+  std::string out;    ///< captured stdout
+  std::string err;    ///< captured stderr
+};
+/// Runs `fluoroct` with the given argument string (shell-quoted by the caller) and captures its output.
+ProcessResult runCli(const std::string& arguments);
+
+}  // namespace fct::test
+
+/// Skips the current test with a message when a file or folder of the shared data is absent.
+#define FCT_REQUIRE_DATA(relative)                                                                   \
+  do {                                                                                               \
+    if (!::fct::test::hasData(relative)) {                                                           \
+      GTEST_SKIP() << "shared data '" << (relative) << "' not found under " << ::fct::test::dataDir() \
+                   << " (set FLUOROCT_DATA_DIR)";                                                    \
+    }                                                                                                \
+  } while (0)

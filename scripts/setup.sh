@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs the Debian packages FluoroCT needs (only those missing), then configures and builds into build/.
+# Sourced by demo.sh and test.sh; safe to run again (fast when nothing is missing or changed).
+set -euo pipefail
+
+FCT_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+FCT_BUILD="${FCT_BUILD_DIR:-$FCT_ROOT/build}"
+
+FCT_PACKAGES=(
+  cmake ninja-build ccache g++ pkg-config
+  qt6-base-dev libqt6opengl6-dev libxkbcommon-dev libgl-dev libvtk9-dev libeigen3-dev libopencv-dev libdcmtk-dev
+  libgtest-dev libgmock-dev nlohmann-json3-dev libfmt-dev libnlopt-cxx-dev libtbb-dev libcli11-dev zlib1g-dev
+  xvfb xauth plastimatch
+)
+
+fct_install_packages() {
+  local missing=()
+  for pkg in "${FCT_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$pkg")
+    fi
+  done
+  if ((${#missing[@]} == 0)); then
+    return 0
+  fi
+  echo "setup: installing missing Debian packages: ${missing[*]}"
+  local sudo=()
+  if [[ $(id -u) -ne 0 ]]; then
+    sudo=(sudo)
+  fi
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+}
+
+fct_build() {
+  local jobs="${FCT_JOBS:-$(nproc)}"
+  if [[ ! -f "$FCT_BUILD/build.ninja" ]]; then
+    cmake -S "$FCT_ROOT" -B "$FCT_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release
+  fi
+  cmake --build "$FCT_BUILD" -j "$jobs"
+}
+
+fct_install_packages
+fct_build
