@@ -305,6 +305,39 @@ Status decodeSlice(const SliceHeader& h, float* hu) {
   return Ok{};
 }
 
+/// Checks a series' headers, sorts them by position along the slice normal and allocates their (empty) SliceStack.
+Result<SliceStack> sortedSliceStack(std::vector<SliceHeader>& headers) {
+  const std::string& uid = headers.front().seriesUid;
+  for (const SliceHeader& h : headers) {
+    if (Status ok = checkSliceHeader(h); !ok) return fail(ok.error());
+    if (Status same = checkSameGrid(headers.front(), h); !same) return fail(same.error());
+  }
+  if (headers.size() < 2) {
+    return fail(fmt::format("series {} has a single image ({}); a CT volume needs at least 2 slices", uid,
+                            headers.front().path.string()));
+  }
+  const Eigen::Vector3d normal = headers.front().rowCosine().cross(headers.front().columnCosine());
+  const auto position = [&](const SliceHeader& h) { return normal.dot(*h.ipp_lps_mm); };
+  std::sort(headers.begin(), headers.end(),
+            [&](const SliceHeader& x, const SliceHeader& y) { return position(x) < position(y); });
+  std::vector<Eigen::Vector3d> origins;
+  for (std::size_t m = 0; m < headers.size(); ++m) {
+    if (m > 0 && position(headers[m]) - position(headers[m - 1]) < SliceStack::kMinGap_mm) {
+      return fail(fmt::format("series {} has two slices at the same position {:.3f} mm ({} and {}): two acquisitions "
+                              "in one series? Separate them before reading", uid, position(headers[m]),
+                              headers[m - 1].path.string(), headers[m].path.string()));
+    }
+    origins.push_back(*headers[m].ipp_lps_mm);
+  }
+  const SliceHeader& first = headers.front();
+  // PixelSpacing is (between rows, between columns) = (spacing along j, spacing along i).
+  const Eigen::Vector2d pixelSpacing_mm((*first.pixelSpacing_mm)[1], (*first.pixelSpacing_mm)[0]);
+  auto stack = SliceStack::create({first.cols, first.rows}, pixelSpacing_mm, first.rowCosine(), first.columnCosine(),
+                                  std::move(origins));
+  if (!stack) return fail(fmt::format("series {}: {}", uid, stack.error()));
+  return stack;
+}
+
 /// "gantry tilt 16.5°", "non-uniform slice spacing 1.08–7.00 mm", or both joined by "and".
 std::string describeIrregularity(const SliceStackLayout& layout) {
   std::string text;
@@ -347,34 +380,8 @@ Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeries
     return fail(fmt::format("series {} not found in {}; available: {}", uid, folder.string(), listSeries(summaries)));
   }
   std::vector<SliceHeader>& headers = found->second;
-
-  for (const SliceHeader& h : headers) {
-    if (Status ok = checkSliceHeader(h); !ok) return fail(ok.error());
-    if (Status same = checkSameGrid(headers.front(), h); !same) return fail(same.error());
-  }
-  if (headers.size() < 2) {
-    return fail(fmt::format("series {} has a single image ({}); a CT volume needs at least 2 slices", uid,
-                            headers.front().path.string()));
-  }
-  const SliceHeader& first = headers.front();
-  const Eigen::Vector3d normal = first.rowCosine().cross(first.columnCosine());
-  const auto position = [&](const SliceHeader& h) { return normal.dot(*h.ipp_lps_mm); };
-  std::sort(headers.begin(), headers.end(),
-            [&](const SliceHeader& x, const SliceHeader& y) { return position(x) < position(y); });
-  std::vector<Eigen::Vector3d> origins;
-  for (std::size_t m = 0; m < headers.size(); ++m) {
-    if (m > 0 && position(headers[m]) - position(headers[m - 1]) < SliceStack::kMinGap_mm) {
-      return fail(fmt::format("series {} has two slices at the same position {:.3f} mm ({} and {}): two acquisitions "
-                              "in one series? Separate them before reading", uid, position(headers[m]),
-                              headers[m - 1].path.string(), headers[m].path.string()));
-    }
-    origins.push_back(*headers[m].ipp_lps_mm);
-  }
-  // PixelSpacing is (between rows, between columns) = (spacing along j, spacing along i).
-  const Eigen::Vector2d pixelSpacing_mm((*first.pixelSpacing_mm)[1], (*first.pixelSpacing_mm)[0]);
-  auto stackResult = SliceStack::create({first.cols, first.rows}, pixelSpacing_mm, first.rowCosine(),
-                                        first.columnCosine(), std::move(origins));
-  if (!stackResult) return fail(fmt::format("series {}: {}", uid, stackResult.error()));
+  auto stackResult = sortedSliceStack(headers);
+  if (!stackResult) return fail(stackResult.error());
   SliceStack& stack = stackResult.value();
   const SliceStackLayout layout = stack.layout();
   const std::string irregularity = describeIrregularity(layout);
@@ -387,6 +394,7 @@ Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeries
     if (Status decoded = decodeSlice(headers[k], stack.slice(k)); !decoded) return fail(decoded.error());
   }
 
+  const SliceHeader& first = headers.front();
   std::vector<std::string> warnings;
   if (summaries.size() > 1 && options.seriesInstanceUid.empty()) {
     warnings.push_back(fmt::format("{} holds {} image series; read the largest, {}. All: {}", folder.string(),
@@ -396,16 +404,18 @@ Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeries
     warnings.push_back(fmt::format("series {} has modality '{}', not CT: voxel values may not be Hounsfield units",
                                    uid, first.modality));
   }
-  std::string description = fmt::format("DICOM series {} '{}' ({}, {} files) from {}", uid, first.seriesDescription,
-                                        first.modality, headers.size(), folder.string());
+  std::string description =
+      fmt::format("DICOM series {} ({}{}, {} files) from {}", uid,
+                  first.seriesDescription.empty() ? "" : "'" + first.seriesDescription + "', ", first.modality,
+                  headers.size(), folder.string());
   Result<Volume> volume = fail("no volume");
   if (layout.isRegular()) {
     volume = std::move(stack).toVolume();
   } else {
+    const double pixel_mm = stack.pixelSpacing_mm().minCoeff();
     const bool automatic = options.resampleSpacing_mm == 0.0;
-    const bool gapBelowPixel = layout.minGap_mm < pixelSpacing_mm.minCoeff();
-    const double spacing_mm = !automatic ? options.resampleSpacing_mm
-                              : gapBelowPixel ? pixelSpacing_mm.minCoeff() : layout.minGap_mm;
+    const bool gapBelowPixel = layout.minGap_mm < pixel_mm;
+    const double spacing_mm = !automatic ? options.resampleSpacing_mm : std::max(layout.minGap_mm, pixel_mm);
     const float outside_hu = std::max(-1024.0f, stack.valueRange().first);
     volume = stack.resampled(spacing_mm, outside_hu);
     const std::string resampling = fmt::format(

@@ -300,7 +300,7 @@ TEST(DicomSeriesReader, RejectsMissingPixelSpacingNamingFileAndTag) {
   EXPECT_TRUE(contains(volume.error(), "PixelSpacing (0028,0030)"));
 }
 
-TEST(DicomSeriesReader, RejectsMixedSizesAndDuplicatePositions) {
+TEST(DicomSeriesReader, RejectsMixedSizesOrientationsAndDuplicatePositions) {
   const fs::path dir = fct::test::scratchDir();
   SyntheticSlice slice;
   writeSeries(dir / "mixed", slice, {0, 1}, "a");
@@ -311,6 +311,15 @@ TEST(DicomSeriesReader, RejectsMixedSizesAndDuplicatePositions) {
   ASSERT_FALSE(mixed.ok());
   EXPECT_TRUE(contains(mixed.error(), "mixes image sizes"));
   EXPECT_TRUE(contains(mixed.error(), "5x6"));
+
+  SyntheticSlice localizer;
+  writeSeries(dir / "oriented", localizer, {0, 1}, "a");
+  localizer.iop = {1, 0, 0, 0, 0, -1};
+  writeSlice(dir / "oriented" / "localizer", localizer);
+  const auto oriented = fct::DicomSeriesReader::read(dir / "oriented");
+  ASSERT_FALSE(oriented.ok());
+  EXPECT_TRUE(contains(oriented.error(), "mixes slice orientations"));
+  EXPECT_TRUE(contains(oriented.error(), "localizer"));
 
   writeSeries(dir / "duplicate", SyntheticSlice{}, {0, 1, 1}, "d");
   const auto duplicate = fct::DicomSeriesReader::read(dir / "duplicate");
