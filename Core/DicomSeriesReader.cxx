@@ -175,6 +175,7 @@ std::map<std::string, std::vector<SliceHeader>> groupBySeries(FolderContents&& c
   return series;
 }
 
+/// One summary per series, the largest first.
 std::vector<DicomSeriesSummary> summarize(const std::map<std::string, std::vector<SliceHeader>>& series) {
   std::vector<DicomSeriesSummary> summaries;
   for (const auto& [uid, headers] : series) {
@@ -187,6 +188,7 @@ std::vector<DicomSeriesSummary> summarize(const std::map<std::string, std::vecto
   return summaries;
 }
 
+/// "uid (140 CT files, 'description'), ..." for error messages and warnings.
 std::string listSeries(const std::vector<DicomSeriesSummary>& summaries) {
   std::string list;
   for (const auto& s : summaries) {
