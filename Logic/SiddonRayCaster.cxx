@@ -19,49 +19,66 @@ inline double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const 
   if (!DrrRayGeometry::clipToBox(a_ijk, d, vol.boxMin_ijk(), vol.boxMax_ijk(), t0, t1)) return 0.0;
 
   // Grid coordinates: voxel m covers [m, m+1) along each axis, the volume covers [0, n).
+  // Per axis: current voxel index, its step (+1, -1, 0), the matching offset step in the voxel array, the parameter
+  // t of the next voxel boundary and the t between boundaries. Kept in scalars so the loop runs in registers.
   const Eigen::Vector3i& n = vol.dims();
   const std::ptrdiff_t stride[3] = {1, n.x(), static_cast<std::ptrdiff_t>(n.x()) * n.y()};
-  int index[3];
-  int step[3];
-  std::ptrdiff_t offsetStep[3];
-  double tNext[3];
-  double tDelta[3];
+  struct Axis {
+    int index, step, size;
+    std::ptrdiff_t offsetStep;
+    double tNext, tDelta;
+  };
+  Axis axes[3];
   std::ptrdiff_t offset = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double g = a_ijk[axis] + 0.5;
-    const double entry = g + t0 * d[axis];
-    index[axis] = std::clamp(static_cast<int>(std::floor(entry)), 0, n[axis] - 1);
-    offset += index[axis] * stride[axis];
-    if (d[axis] > 0.0) {
-      step[axis] = 1;
-      tDelta[axis] = 1.0 / d[axis];
-      tNext[axis] = (index[axis] + 1 - g) * tDelta[axis];
-    } else if (d[axis] < 0.0) {
-      step[axis] = -1;
-      tDelta[axis] = -1.0 / d[axis];
-      tNext[axis] = (g - index[axis]) * tDelta[axis];
+  for (int a = 0; a < 3; ++a) {
+    Axis& axis = axes[a];
+    const double g = a_ijk[a] + 0.5;
+    axis.size = n[a];
+    axis.index = std::clamp(static_cast<int>(std::floor(g + t0 * d[a])), 0, n[a] - 1);
+    offset += axis.index * stride[a];
+    if (d[a] > 0.0) {
+      axis.step = 1;
+      axis.tDelta = 1.0 / d[a];
+      axis.tNext = (axis.index + 1 - g) * axis.tDelta;
+    } else if (d[a] < 0.0) {
+      axis.step = -1;
+      axis.tDelta = -1.0 / d[a];
+      axis.tNext = (g - axis.index) * axis.tDelta;
     } else {
-      step[axis] = 0;
-      tDelta[axis] = 0.0;
-      tNext[axis] = std::numeric_limits<double>::infinity();
+      axis.step = 0;
+      axis.tDelta = 0.0;
+      axis.tNext = std::numeric_limits<double>::infinity();
     }
-    offsetStep[axis] = step[axis] * stride[axis];
+    axis.offsetStep = axis.step * stride[a];
   }
 
   const float* data = vol.data();
   double sum = 0.0;
   double t = t0;
+  Axis x = axes[0], y = axes[1], z = axes[2];
+  // Crosses the next boundary of `axis`: adds the path in the current voxel and moves to the neighbour. Returns false
+  // when the ray ends first (t1) or leaves the grid.
+  const auto cross = [&](Axis& axis) {
+    if (axis.tNext >= t1) return false;
+    sum += (axis.tNext - t) * data[offset];
+    t = axis.tNext;
+    axis.index += axis.step;
+    if (static_cast<unsigned>(axis.index) >= static_cast<unsigned>(axis.size)) {
+      t = t1;  // left the grid within rounding of t1: nothing remains
+      return false;
+    }
+    offset += axis.offsetStep;
+    axis.tNext += axis.tDelta;
+    return true;
+  };
   for (;;) {
-    const int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
-    const double tEnd = std::min(tNext[axis], t1);
-    sum += (tEnd - t) * data[offset];
-    if (tEnd >= t1) break;
-    t = tEnd;
-    index[axis] += step[axis];
-    if (static_cast<unsigned>(index[axis]) >= static_cast<unsigned>(n[axis])) break;
-    offset += offsetStep[axis];
-    tNext[axis] += tDelta[axis];
+    if (x.tNext < y.tNext) {
+      if (!(x.tNext < z.tNext ? cross(x) : cross(z))) break;
+    } else if (!(y.tNext < z.tNext ? cross(y) : cross(z))) {
+      break;
+    }
   }
+  if (t < t1) sum += (t1 - t) * data[offset];
   return sum * length_mm;
 }
 
