@@ -167,6 +167,9 @@ Status ViewFile::write(const std::vector<ViewSpec>& views, const std::filesystem
       return fail(fmt::format("cannot write '{}': view name '{}' is used twice", path.string(), view.name));
     }
     const CameraIntrinsics& in = view.camera.intrinsics();
+    if (auto valid = Camera::create(in, view.camera.T_world_from_camera()); !valid) {
+      return fail(fmt::format("cannot write '{}': view '{}': {}", path.string(), view.name, valid.error()));
+    }
     ordered_json v;
     v["name"] = view.name;
     if (!view.imagePath.empty()) {

@@ -37,7 +37,8 @@ class ViewFile {
 
   /// Writes the views (camera as T_world_from_camera + intrinsics) atomically. Image paths inside the file's folder
   /// are written relative to it, others absolute (a relative imagePath is taken relative to the current folder).
-  /// Fails on an empty list, empty or duplicate names, or an unwritable path.
+  /// Fails on an empty list, empty or duplicate names, an invalid camera (e.g. default-constructed), or an
+  /// unwritable path.
   static Status write(const std::vector<ViewSpec>& views, const std::filesystem::path& path);
 };
 

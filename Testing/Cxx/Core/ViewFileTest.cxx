@@ -260,6 +260,11 @@ TEST(ViewFile, WriteFailsOnUnwritablePathOrDuplicateNamesAndWritesNothing) {
   status = fct::ViewFile::write(views, dir / "views.json");
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.error().find("'AP' is used twice"), std::string::npos) << status.error();
-  EXPECT_TRUE(std::filesystem::is_empty(dir));
+  views.pop_back();
+  views[0].camera = fct::Camera();  // 0 x 0 detector
+  status = fct::ViewFile::write(views, dir / "views.json");
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.error().find("view 'AP': detector size must be positive"), std::string::npos) << status.error();
   EXPECT_FALSE(fct::ViewFile::write({}, dir / "views.json").ok());
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
