@@ -191,6 +191,36 @@ Result<std::vector<float>> modalityTable(DcmItem& ds, const LoadedFile& loaded, 
   return table;
 }
 
+/// The DICOM patient-direction letter (L/R, P/A, H/F) closest to a direction in LPS.
+char directionLetter(const Eigen::Vector3d& direction_lps) {
+  Eigen::Index axis = 0;
+  direction_lps.cwiseAbs().maxCoeff(&axis);
+  static constexpr std::array<char, 3> kPositive{'L', 'P', 'H'};
+  static constexpr std::array<char, 3> kNegative{'R', 'A', 'F'};
+  return direction_lps[axis] >= 0.0 ? kPositive[static_cast<std::size_t>(axis)] : kNegative[static_cast<std::size_t>(axis)];
+}
+
+/// A warning when PatientOrientation (0020,0020) contradicts the camera's column/row directions (e.g. an image
+/// stored mirrored, as displayed); empty when the tag is absent, not in biped letters, or consistent.
+std::string orientationConflict(DcmItem& ds, const Camera& camera, const std::string& name) {
+  const std::string columnTag = stringTag(ds, DCM_PatientOrientation);
+  OFString rowText;
+  if (columnTag.empty() || ds.findAndGetOFString(DCM_PatientOrientation, rowText, 1).bad()) return {};
+  const std::string rowTag = trimmed(rowText);
+  const std::string letters = "LRAPHF";
+  if (rowTag.empty() || letters.find(columnTag[0]) == std::string::npos || letters.find(rowTag[0]) == std::string::npos) {
+    return {};
+  }
+  const Eigen::Matrix3d R = camera.T_world_from_camera().linear();
+  const char column = directionLetter(R.col(0));
+  const char row = directionLetter(R.col(1));
+  if (column == columnTag[0] && row == rowTag[0]) return {};
+  return fmt::format("'{}': PatientOrientation (0020,0020) is {}\\{} but the camera from the positioner angles has "
+                     "columns toward {} and rows toward {}; the image is probably stored mirrored or rotated (as "
+                     "displayed) - flip it to the view from the source or supply the camera in a view file",
+                     name, columnTag, rowTag, column, row);
+}
+
 }  // namespace
 
 Result<XrayDicomHeader> XrayDicomReader::readHeader(const std::filesystem::path& path) {
@@ -281,6 +311,9 @@ Result<XrayImage> XrayDicomReader::read(const std::filesystem::path& path, int f
     for (const auto& w : camera.warnings()) warnings.push_back(w);
     if (camera) {
       image.camera = camera.value();
+      if (std::string conflict = orientationConflict(ds, camera.value(), name); !conflict.empty()) {
+        warnings.push_back(std::move(conflict));
+      }
     } else {
       warnings.push_back(fmt::format("'{}': no camera from the DICOM tags: {}", name, camera.error()));
     }

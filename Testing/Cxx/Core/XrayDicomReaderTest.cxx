@@ -313,6 +313,37 @@ TEST(XrayDicomReader, CameraAtZeroAnglesLooksAnteriorWithPatientRightAlongColumn
   EXPECT_NE(camera.warnings()[0].find("assumed 0"), std::string::npos);
 }
 
+TEST(XrayDicomReader, WarnsWhenPatientOrientationContradictsTheCamera) {
+  SyntheticXray x;
+  x.samples = ramp(20, 0, 1);
+  const auto dir = fct::test::scratchDir();
+  auto readWithOrientation = [&](const char* orientation, const char* fileName) {
+    DcmFileFormat file = x.build();
+    DcmDataset* ds = file.getDataset();
+    ds->putAndInsertString(DCM_DistanceSourceToDetector, "1000");
+    ds->putAndInsertString(DCM_DistanceSourceToPatient, "750");
+    ds->putAndInsertString(DCM_ImagerPixelSpacing, "0.2\\0.2");
+    ds->putAndInsertString(DCM_PositionerPrimaryAngle, "0");
+    ds->putAndInsertString(DCM_PositionerSecondaryAngle, "0");
+    ds->putAndInsertString(DCM_PatientOrientation, orientation);
+    return XrayDicomReader::read(save(file, dir / fileName));
+  };
+  auto hasMirrorWarning = [](const fct::Result<fct::XrayImage>& image) {
+    return std::any_of(image.warnings().begin(), image.warnings().end(),
+                       [](const std::string& w) { return w.find("mirrored") != std::string::npos; });
+  };
+  auto seenFromSource = readWithOrientation("R\\F", "from_source.dcm");
+  ASSERT_TRUE(seenFromSource) << seenFromSource.error();
+  EXPECT_TRUE(seenFromSource.value().camera.has_value());
+  EXPECT_FALSE(hasMirrorWarning(seenFromSource));
+  EXPECT_TRUE(seenFromSource.warnings().empty());  // complete geometry, explicit angles: nothing to say
+
+  auto asDisplayed = readWithOrientation("L\\F", "as_displayed.dcm");
+  ASSERT_TRUE(asDisplayed) << asDisplayed.error();
+  EXPECT_TRUE(asDisplayed.value().camera.has_value());
+  EXPECT_TRUE(hasMirrorWarning(asDisplayed));
+}
+
 TEST(XrayDicomReader, CameraErrorNamesEveryMissingValue) {
   fct::XrayGeometryTags tags;
   tags.sourceToDetector_mm = 1000.0;
