@@ -168,7 +168,12 @@ Result<std::vector<float>> modalityTable(DcmItem& ds, const LoadedFile& loaded, 
                               "missing",
                               name));
     }
-    const long n = std::min<long>(*entries == 0 ? 65536 : *entries, static_cast<long>(count));
+    const long n = *entries == 0 ? 65536L : static_cast<long>(*entries);
+    if (static_cast<long>(count) < n) {
+      return fail(fmt::format("'{}': Modality LUT has {} entries in LUTDescriptor but only {} 16-bit values in LUTData; "
+                              "8-bit packed LUTs are not supported",
+                              name, n, count));
+    }
     const long first = static_cast<long>(*firstMapped);
     for (long s = lo; s <= hi; ++s) {
       const long index = std::clamp(s - first, 0L, n - 1);
@@ -288,7 +293,7 @@ Result<XrayImage> XrayDicomReader::read(const std::filesystem::path& path, int f
   image.pixels.resize(static_cast<std::size_t>(h.cols) * h.rows);
 
   const int shift = loaded.highBit + 1 - h.bitsStored;
-  const std::uint32_t mask = (h.bitsStored >= 32) ? 0xFFFFFFFFU : ((1U << h.bitsStored) - 1U);
+  const std::uint32_t mask = (1U << h.bitsStored) - 1U;  // bitsStored <= 16 (validated)
   const std::uint32_t signBit = 1U << (h.bitsStored - 1);
   const long lo = loaded.signedPixels ? -(1L << (h.bitsStored - 1)) : 0L;
   for (std::size_t i = 0; i < image.pixels.size(); ++i) {

@@ -237,6 +237,26 @@ TEST(XrayDicomReader, InvertsTwelveBitMonochrome1WithinStoredBitsThenRescales) {
   EXPECT_FLOAT_EQ(image.value().at(0, 0), 2.0f * 4095 - 10);  // darkest MONOCHROME1 value = most signal
 }
 
+TEST(XrayDicomReader, AppliesModalityLutClampingOutsideItsRange) {
+  SyntheticXray x;
+  x.cols = 4;
+  x.rows = 1;
+  x.bitsAllocated = 8;
+  x.bitsStored = 8;
+  x.samples = {0, 1, 3, 200};
+  DcmFileFormat file = x.build();
+  DcmItem* lut = nullptr;
+  ASSERT_TRUE(file.getDataset()->findOrCreateSequenceItem(DCM_ModalityLUTSequence, lut, 0).good());
+  const Uint16 descriptor[3] = {3, 1, 16};  // 3 entries, first mapped stored value 1
+  const Uint16 data[3] = {100, 200, 300};
+  lut->putAndInsertUint16Array(DCM_LUTDescriptor, descriptor, 3);
+  lut->putAndInsertUint16Array(DCM_LUTData, data, 3);
+  const auto path = save(file, fct::test::scratchDir() / "modality_lut.dcm");
+  auto image = XrayDicomReader::read(path);
+  ASSERT_TRUE(image) << image.error();
+  EXPECT_EQ(image.value().pixels, (std::vector<float>{100, 100, 300, 300}));
+}
+
 TEST(XrayDicomReader, ReadsRequestedFrameOfSixteenBitMultiFrame) {
   SyntheticXray x;
   x.frames = 3;
