@@ -183,7 +183,7 @@ TEST(XrayDicomReader, DecodesJpegMultiFrameAngiogramFrameByFrame) {
   EXPECT_NE(beyond.error().find("96 frames"), std::string::npos) << beyond.error();
 }
 
-TEST(XrayDicomReader, InvertsJpegMonochrome1ChestToDetectorSignal) {
+TEST(XrayDicomReader, InvertsJpegMonochrome1ChestToMonochrome2) {
   FCT_REQUIRE_DATA("xray/cr_chest_monochrome1_jpeg.dcm");
   const auto path = fct::test::dataDir() / "xray/cr_chest_monochrome1_jpeg.dcm";
   auto header = XrayDicomReader::readHeader(path);
