@@ -75,7 +75,7 @@ Result<Volume> NiftiReader::read(const std::filesystem::path& path) {
   const bool swap = sizeofHdr != 348;
   const HeaderView h(bytes, swap);
   if (h.get<std::int32_t>(0) != 348) {
-    if (h.get<std::int32_t>(0) == 540) {
+    if (sizeofHdr == 540 || HeaderView(bytes, true).get<std::int32_t>(0) == 540) {
       return fail(fmt::format("{} is NIfTI-2, which is not supported; convert it to NIfTI-1 or NRRD", source));
     }
     return fail(fmt::format("{} is not a NIfTI-1 file (header size field is not 348)", source));

@@ -120,6 +120,9 @@ Result<Volume> NrrdFormat::read(const std::filesystem::path& path) {
       if (!o.ok()) return fail(fmt::format("{}: {}", source, o.error()));
       origin = Eigen::Map<const Eigen::Vector3d>(o.value().data());
     }
+  } else if (directions) {
+    return fail(fmt::format("{} has 'space directions' but no 'space' naming its frame; add 'space: RAS' or "
+                            "'space: LPS' to the header", source));
   } else if (const auto spacings = field("spacings")) {
     auto s = TextHeader::numbers(*spacings, 3, "spacings");
     if (!s.ok()) return fail(fmt::format("{}: {}", source, s.error()));

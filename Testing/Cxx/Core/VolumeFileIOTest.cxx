@@ -179,7 +179,9 @@ TEST(VolumeFileIO, ConvertsRasNrrdToLps) {
       "space directions: (0,2,0) (-1.5,0,0) (0,0,3)\nkinds: domain domain domain\nendian: little\n";
   writeFile(dir / "ras.nrrd", header + "encoding: raw\nspace origin: (10,20,-5)\n\n" + voxels);
   writeFile(dir / "ras_gz.nrrd", header + "encoding: gzip\nspace origin: (10,20,-5)\n\n" + gzipBytes(voxels));
-  for (const char* name : {"ras.nrrd", "ras_gz.nrrd"}) {
+  writeFile(dir / "ras.nhdr", header + "encoding: gzip\nspace origin: (10,20,-5)\ndata file: ras.raw.gz\n");
+  writeFile(dir / "ras.raw.gz", gzipBytes(voxels));
+  for (const char* name : {"ras.nrrd", "ras_gz.nrrd", "ras.nhdr"}) {
     SCOPED_TRACE(name);
     auto result = fct::VolumeFileIO::read(dir / name);
     ASSERT_TRUE(result.ok()) << result.error();
@@ -245,6 +247,9 @@ TEST(VolumeFileIO, RejectsMissingUnknownTruncatedAndMalformedFiles) {
   writeFile(dir / "scanner.nrrd", "NRRD0004\ntype: uchar\ndimension: 3\nspace: scanner-xyz\nsizes: 1 1 1\n"
                                   "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\nx");
   EXPECT_NE(fct::VolumeFileIO::read(dir / "scanner.nrrd").error().find("scanner-xyz"), std::string::npos);
+  writeFile(dir / "unnamed_space.nrrd", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\n"
+                                        "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\nx");
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "unnamed_space.nrrd").error().find("no 'space'"), std::string::npos);
   writeFile(dir / "garbage.nii", std::string(400, 'x'));
   EXPECT_NE(fct::VolumeFileIO::read(dir / "garbage.nii").error().find("not a NIfTI-1"), std::string::npos);
 }
