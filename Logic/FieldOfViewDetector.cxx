@@ -109,21 +109,21 @@ Result<FieldOfView> FieldOfViewDetector::detect(const FloatImage& image) const {
   }
 
   std::vector<float> sorted = image.pixels;
-  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-  std::nth_element(sorted.begin(), mid, sorted.end());
-  const float median = *mid;
+  const auto p90 = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() * 9 / 10);
+  std::nth_element(sorted.begin(), p90, sorted.end());
+  const float bright = *p90;
   const float minimum = *std::min_element(image.pixels.begin(), image.pixels.end());
-  const auto threshold = static_cast<float>(minimum + o.backgroundLevel * (median - minimum));
+  const auto threshold = static_cast<float>(minimum + o.backgroundLevel * (bright - minimum));
 
+  if (bright <= minimum) {
+    return fail(fmt::format("X-ray is at its minimum value {} over at least 90 % of its pixels; no field of view "
+                            "found (is the image blank?)",
+                            minimum));
+  }
   const int cols = image.cols;
   const int rows = image.rows;
   FieldOfView result;
   result.mask = ValidMask::allValid(cols, rows);
-  if (median <= minimum) {  // more than half the image at its minimum: nothing sensible to call the field
-    return fail(fmt::format("X-ray is at its minimum value {} over at least half of its pixels; no field of view "
-                            "found (is the image blank?)",
-                            minimum));
-  }
   const std::vector<std::uint8_t> background = borderConnectedBackground(image, threshold);
   const std::size_t backgroundCount = static_cast<std::size_t>(std::count(background.begin(), background.end(), 1));
   result.backgroundFraction = static_cast<double>(backgroundCount) / static_cast<double>(background.size());

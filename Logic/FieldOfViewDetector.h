@@ -2,8 +2,8 @@
 // FieldOfViewDetector: finds the exposed field of view of an X-ray (the circular image-intensifier field or a
 // collimated area) so that the dark background and the blurred collimator edge are excluded from comparison.
 //
-// Method: the background is every pixel at or below a low level, t = min + backgroundLevel * (median - min) of the
-// image, that is connected (4-neighbourhood) to the image border; dark bone inside the field is not connected to the
+// Method: the background is every pixel at or below a low level, t = min + backgroundLevel * (p90 - min) of the
+// image (p90 its 90th percentile, a level inside the field even when most of the image is collimated), that is connected (4-neighbourhood) to the image border; dark bone inside the field is not connected to the
 // border through dark pixels and stays in the field. The field's boundary pixels (field pixels with a background
 // 4-neighbour, not on the image border) are fitted by a circle (algebraic least squares, then twice refitted
 // without outliers beyond 3 median residuals + 1 px). When the fit's median residual is within
@@ -22,10 +22,10 @@ namespace fct {
 
 /// Settings of the field-of-view detection.
 struct FieldOfViewOptions {
-  double backgroundLevel = 0.1;         ///< background threshold as a fraction of (median - min) above the minimum
+  double backgroundLevel = 0.1;         ///< background threshold as a fraction of (p90 - min) above the minimum
   double minBackgroundFraction = 0.01;  ///< below this fraction of background pixels the whole image is field
   double maxCircleResidual_px = 2.0;    ///< median distance of boundary pixels to the circle for a circular field
-  int inset_px = 8;                     ///< pixels removed inside the detected boundary (covers the edge blur)
+  int inset_px = 12;                    ///< pixels removed inside the detected boundary (covers the edge blur)
 };
 
 /// What was found: the mask of usable pixels and, for a circular field, the fitted boundary circle.
