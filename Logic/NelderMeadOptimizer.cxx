@@ -12,6 +12,7 @@ namespace fct {
 namespace {
 
 constexpr int kN = 6;
+constexpr int kReportInterval = 25;  // evaluations between progress reports of a stand-alone run
 // Gao & Han (2012) adaptive coefficients for dimension n.
 constexpr double kReflect = 1.0;
 constexpr double kExpand = 1.0 + 2.0 / kN;
@@ -143,6 +144,7 @@ Result<OptimizationResult> NelderMeadOptimizer::minimize(const PoseObjective& ob
   if (auto status = validateInputs(objective, start, scales); !status) return fail(status.error());
   if (auto status = validateOptions(); !status) return fail(status.error());
   ObjectiveEvaluator evaluator(objective, start, scales, m_options.maxEvaluations, monitor);
+  evaluator.reportEvery(kReportInterval, name());
   bool converged = false;
   (void)searchScaled(evaluator, evaluator.toScaled(start), &converged);
   OptimizationResult result = evaluator.result(converged);

@@ -1,5 +1,7 @@
 #include "ObjectiveEvaluator.h"
 
+#include <fmt/core.h>
+
 #include <cmath>
 #include <limits>
 
@@ -27,6 +29,10 @@ double ObjectiveEvaluator::atScaled(const PoseVector& y_scaled) {
   if (value < m_bestValue) {
     m_bestValue = value;
     m_bestParams = params;
+  }
+  if (m_reportInterval > 0 && m_evaluations % m_reportInterval == 0) {
+    m_monitor.report(m_reportStage, static_cast<double>(m_evaluations) / m_maxEvaluations,
+                     fmt::format("{} evaluations, best value {:.6g}", m_evaluations, m_bestValue));
   }
   return value;
 }

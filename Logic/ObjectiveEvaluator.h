@@ -17,6 +17,11 @@ class ObjectiveEvaluator {
 
   /// Objective at scaled coordinates y; +infinity for NaN, and +infinity without evaluating once stopped().
   double atScaled(const PoseVector& y_scaled);
+  /// Also sends a progress report under `stage` every `interval` evaluations (fraction = evaluations / maximum).
+  void reportEvery(int interval, std::string stage) {
+    m_reportInterval = interval;
+    m_reportStage = std::move(stage);
+  }
   /// Parameters (deg, mm) of scaled coordinates.
   PoseVector toParams(const PoseVector& y_scaled) const { return y_scaled.cwiseProduct(m_scales); }
   /// Scaled coordinates of parameters (deg, mm).
@@ -41,6 +46,8 @@ class ObjectiveEvaluator {
   PoseVector m_scales;
   int m_maxEvaluations;
   const ProgressMonitor& m_monitor;
+  int m_reportInterval = 0;
+  std::string m_reportStage;
   int m_evaluations = 0;
   bool m_cancelled = false;
   double m_bestValue;

@@ -19,9 +19,14 @@ TEST(NelderMeadOptimizer, ConvergesOnScaledBowlWithinTolerance) {
   start << 0, 0, 0, 0, 0, 0;
   NelderMeadOptions options;
   options.tolerance = 0.001;
-  const auto result = NelderMeadOptimizer(options).minimize(t::bowl(target, scales), start, scales);
+  std::vector<fct::ProgressUpdate> updates;
+  const fct::ProgressMonitor monitor([&](const fct::ProgressUpdate& u) { updates.push_back(u); }, nullptr);
+  const auto result = NelderMeadOptimizer(options).minimize(t::bowl(target, scales), start, scales, monitor);
   ASSERT_TRUE(result.ok()) << result.error();
   EXPECT_TRUE(result.value().converged);
+  ASSERT_GE(updates.size(), 2u);  // periodic reports and the final one
+  EXPECT_EQ(updates.front().stage, "nelder-mead");
+  EXPECT_EQ(updates.front().message.rfind("25 evaluations", 0), 0u) << updates.front().message;
   EXPECT_FALSE(result.value().cancelled);
   EXPECT_LT((result.value().params - target).cwiseQuotient(scales).cwiseAbs().maxCoeff(), 0.01);
   EXPECT_LT(result.value().value, 1e-4);
