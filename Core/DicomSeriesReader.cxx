@@ -3,7 +3,6 @@
 #include <dcmtk/dcmdata/dcdeftag.h>
 #include <dcmtk/dcmdata/dcfilefo.h>
 #include <dcmtk/dcmdata/dcxfer.h>
-#include <dcmtk/oflog/oflog.h>
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -12,7 +11,7 @@
 #include <cstdint>
 #include <fstream>
 #include <map>
-#include <mutex>
+
 #include <optional>
 
 #include "DicomCodecs.h"
@@ -23,13 +22,6 @@ namespace fct {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// DCMTK reports parse problems both through OFCondition (which we convert) and its logger (stderr noise): keep
-/// only fatal messages.
-void quietDcmtkLogging() {
-  static std::once_flag once;
-  std::call_once(once, [] { OFLog::getLogger("dcmtk").setLogLevel(OFLogger::FATAL_LOG_LEVEL); });
-}
 
 /// The header fields of one DICOM image file that series grouping, sorting and decoding need.
 struct SliceHeader {
@@ -358,14 +350,13 @@ std::string describeIrregularity(const SliceStackLayout& layout) {
 }  // namespace
 
 Result<std::vector<DicomSeriesSummary>> DicomSeriesReader::scan(const fs::path& folder) {
-  quietDcmtkLogging();
+  DicomCodecs::ensureRegistered();
   auto contents = scanFolder(folder);
   if (!contents) return fail(contents.error());
   return summarize(groupBySeries(std::move(contents).value()));
 }
 
 Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeriesReadOptions& options) {
-  quietDcmtkLogging();
   DicomCodecs::ensureRegistered();
   if (!std::isfinite(options.resampleSpacing_mm) || options.resampleSpacing_mm < 0.0) {
     return fail(fmt::format("resample spacing must be 0 (automatic) or a positive number of mm, got {}",
