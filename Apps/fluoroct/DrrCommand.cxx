@@ -68,6 +68,9 @@ int runDrr(const DrrCommandOptions& options) {
       extension != ".png") {
     return reportError(fmt::format("--out '{}' must end in .nrrd, .pfm, .tif or .png", options.out));
   }
+  if (!out.parent_path().empty() && !fs::is_directory(out.parent_path())) {
+    return reportError(fmt::format("output folder '{}' does not exist; create it first", out.parent_path().string()));
+  }
   const auto method = DrrRendererFactory::parseMethod(options.method);
   if (!method.ok()) return reportError(method.error());
   const auto valueKind = DrrVolume::parseValueKind(options.values);

@@ -121,6 +121,7 @@ TEST(DrrCommand, FailsWithOneErrorLineAndWritesNothingOnBadInput) {
       {f.baseArguments() + fmt::format(" --method raytrace --out '{}'", out), "'raycast' or 'siddon'"},
       {f.baseArguments() + fmt::format(" --values hu --out '{}'", out), "'attenuation' or 'raw'"},
       {f.baseArguments() + fmt::format(" --out '{}'", (f.out / "bad.jpg").string()), ".nrrd, .pfm, .tif or .png"},
+      {f.baseArguments() + fmt::format(" --out '{}'", (f.out / "no" / "d.tif").string()), "does not exist"},
       {f.baseArguments() + fmt::format(" --level 6 --out '{}'", out), "leaves no pixels"},
       {f.baseArguments() + fmt::format(" --level -1 --out '{}'", out), "--level"},
       {f.baseArguments() + fmt::format(" --pose '{}' --out '{}'", f.views.string(), out), "error: "},
