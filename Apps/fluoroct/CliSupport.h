@@ -20,6 +20,8 @@ int reportError(const std::string& message);
 // Each command file provides a register function: it adds its subcommand to `app` and, when the subcommand is
 // chosen, stores its action in `action` (run after parsing).
 
+/// `fluoroct info`: describes a CT or an X-ray (text or --json).
+void registerInfoCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct phantom`: writes the built-in procedural CT phantom to a NRRD or MetaImage file.
 void registerPhantomCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct drr`: renders DRRs of a CT for the views of a view file.

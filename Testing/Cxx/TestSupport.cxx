@@ -32,7 +32,6 @@ std::filesystem::path scratchDir() {
 std::filesystem::path cliPath() { return FCT_CLI_PATH; }
 
 ProcessResult runCli(const std::string& arguments) {
-  // Not scratchDir(): that would wipe the calling test's files (its inputs to the command).
   const auto dir = std::filesystem::temp_directory_path() / "fluoroct_tests" / "cli_capture";
   std::filesystem::create_directories(dir);
   const auto outPath = dir / fmt::format("out_{}.txt", ::getpid());
