@@ -11,13 +11,12 @@
 #include <vector>
 
 #include "CliSupport.h"
-#include "DicomSeriesReader.h"
+#include "CtLoader.h"
 #include "DrrRendererFactory.h"
 #include "DrrVolume.h"
 #include "ImageFileWriter.h"
 #include "PoseFile.h"
 #include "ViewFile.h"
-#include "VolumeFileIO.h"
 
 namespace fct::cli {
 
@@ -50,15 +49,6 @@ Status writeDrr(const FloatImage& image, const fs::path& path, const std::string
   if (extension == ".tif" || extension == ".tiff") return ImageFileWriter::writeTiff(image, path);
   const auto [lo, hi] = std::minmax_element(image.pixels.begin(), image.pixels.end());
   return ImageFileWriter::writePng16(image, path, *lo, *hi > *lo ? *hi : *lo + 1.0f);
-}
-
-Result<Volume> readCt(const fs::path& path) {
-  if (fs::is_directory(path)) {
-    auto ct = DicomSeriesReader::read(path);
-    for (const auto& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
-    return ct;
-  }
-  return VolumeFileIO::read(path);
 }
 
 int runDrr(const DrrCommandOptions& options) {
@@ -96,8 +86,9 @@ int runDrr(const DrrCommandOptions& options) {
     T_world_from_ct = pose.value();
   }
 
-  const auto ct = readCt(options.ct);
+  const auto ct = CtLoader::load(options.ct);
   if (!ct.ok()) return reportError(ct.error());
+  for (const auto& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
   DrrValueOptions valueOptions;
   valueOptions.kind = valueKind.value();
   auto drrVolume = DrrVolume::create(ct.value(), valueOptions);
