@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 
 namespace fct {
 
@@ -42,7 +43,38 @@ Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& opt
   if (nonFinite > 0) {
     return fail(fmt::format("the CT has {} voxels that are NaN or infinite; repair or re-export the volume", nonFinite));
   }
+  volume.findContentBox();
   return volume;
+}
+
+void DrrVolume::findContentBox() {
+  const Eigen::Vector3i n = dims();
+  const std::vector<float>& voxels = m_values.voxels();
+  struct Box {
+    Eigen::Vector3i first = Eigen::Vector3i::Constant(std::numeric_limits<int>::max());
+    Eigen::Vector3i last = Eigen::Vector3i::Constant(-1);
+    Box merged(const Box& other) const { return {first.cwiseMin(other.first), last.cwiseMax(other.last)}; }
+  };
+  const Box box = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, n.z()), Box{},
+      [&](const tbb::blocked_range<int>& slices, Box box) {
+        for (int k = slices.begin(); k != slices.end(); ++k) {
+          for (int j = 0; j < n.y(); ++j) {
+            const float* row = voxels.data() + m_values.offset(0, j, k);
+            int i = 0;
+            while (i < n.x() && row[i] == 0.0f) ++i;
+            if (i == n.x()) continue;
+            int last = n.x() - 1;
+            while (row[last] == 0.0f) --last;
+            box.first = box.first.cwiseMin(Eigen::Vector3i(i, j, k));
+            box.last = box.last.cwiseMax(Eigen::Vector3i(last, j, k));
+          }
+        }
+        return box;
+      },
+      [](const Box& a, const Box& b) { return a.merged(b); });
+  m_contentFirst_ijk = box.last.x() < 0 ? Eigen::Vector3i::Zero() : box.first;
+  m_contentLast_ijk = box.last;
 }
 
 Result<DrrValueKind> DrrVolume::parseValueKind(std::string_view name) {

@@ -59,12 +59,24 @@ class DrrVolume {
   Eigen::Vector3d boxMin_ijk() const { return Eigen::Vector3d::Constant(-0.5); }
   /// Upper corner of the voxel boxes in index space: dims - 0.5.
   Eigen::Vector3d boxMax_ijk() const { return dims().cast<double>().array() - 0.5; }
+  /// True when at least one value is non-zero (otherwise every DRR is zero).
+  bool hasContent() const { return (m_contentFirst_ijk.array() <= m_contentLast_ijk.array()).all(); }
+  /// Lower corner, in index space, of the smallest box of whole voxels holding every non-zero value (air is 0 in
+  /// attenuation values, so this is usually the patient, not the scan field); only meaningful when hasContent().
+  Eigen::Vector3d contentBoxMin_ijk() const { return m_contentFirst_ijk.cast<double>().array() - 0.5; }
+  /// Upper corner of that box in index space.
+  Eigen::Vector3d contentBoxMax_ijk() const { return m_contentLast_ijk.cast<double>().array() + 0.5; }
 
  private:
+  /// Sets the content box from the values.
+  void findContentBox();
+
   Volume m_values;
   DrrValueOptions m_options;
   Eigen::Affine3d m_T_ijk_from_ct = Eigen::Affine3d::Identity();
   Eigen::Affine3d m_T_ct_from_ijk = Eigen::Affine3d::Identity();
+  Eigen::Vector3i m_contentFirst_ijk = Eigen::Vector3i::Zero();       ///< first voxel index of the content box
+  Eigen::Vector3i m_contentLast_ijk = Eigen::Vector3i::Constant(-1);  ///< last voxel index (first > last: none)
 };
 
 }  // namespace fct

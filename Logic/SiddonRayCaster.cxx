@@ -16,7 +16,11 @@ inline double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const 
   const Eigen::Vector3d d = b_ijk - a_ijk;
   double t0 = 0.0;
   double t1 = 1.0;
-  if (!DrrRayGeometry::clipToBox(a_ijk, d, vol.boxMin_ijk(), vol.boxMax_ijk(), t0, t1)) return 0.0;
+  // Only the box of non-zero voxels contributes; clipping to it skips the air around the patient.
+  if (!vol.hasContent() ||
+      !DrrRayGeometry::clipToBox(a_ijk, d, vol.contentBoxMin_ijk(), vol.contentBoxMax_ijk(), t0, t1)) {
+    return 0.0;
+  }
 
   // Grid coordinates: voxel m covers [m, m+1) along each axis, the volume covers [0, n).
   // Per axis: current voxel index, its step (+1, -1, 0), the matching offset step in the voxel array, the parameter

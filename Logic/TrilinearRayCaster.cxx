@@ -10,7 +10,11 @@ namespace fct {
 
 TrilinearRayCaster::TrilinearRayCaster(std::shared_ptr<const DrrVolume> volume, double step_mm)
     : DrrRenderer(std::move(volume)),
-      m_step_mm(std::isfinite(step_mm) && step_mm > 0.0 ? step_mm : defaultStep_mm(this->volume())) {}
+      m_step_mm(std::isfinite(step_mm) && step_mm > 0.0 ? step_mm : defaultStep_mm(this->volume())) {
+  const DrrVolume& vol = this->volume();
+  m_clipMin_ijk = (vol.contentBoxMin_ijk().array() - 0.5).max(vol.boxMin_ijk().array());
+  m_clipMax_ijk = (vol.contentBoxMax_ijk().array() + 0.5).min(vol.boxMax_ijk().array());
+}
 
 double TrilinearRayCaster::defaultStep_mm(const DrrVolume& volume) {
   return 0.5 * volume.values().spacing_mm().minCoeff();
@@ -22,7 +26,7 @@ inline double TrilinearRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, con
   const Eigen::Vector3d d = b_ijk - a_ijk;
   double t0 = 0.0;
   double t1 = 1.0;
-  if (!DrrRayGeometry::clipToBox(a_ijk, d, vol.boxMin_ijk(), vol.boxMax_ijk(), t0, t1)) return 0.0;
+  if (!vol.hasContent() || !DrrRayGeometry::clipToBox(a_ijk, d, m_clipMin_ijk, m_clipMax_ijk, t0, t1)) return 0.0;
 
   const double inside_mm = (t1 - t0) * length_mm;
   const long sampleCount = std::max(1L, static_cast<long>(std::ceil(inside_mm / m_step_mm - 1e-9)));

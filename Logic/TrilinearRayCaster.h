@@ -1,8 +1,9 @@
 #pragma once
 // TrilinearRayCaster: DRRs by sampling the volume with trilinear interpolation at a fixed step along each ray
-// (midpoint rule over the part of the ray inside the volume's voxel boxes; the step is shortened so that a whole
-// number of steps covers that part exactly). Beyond the outermost voxel centres the edge voxels' values extend
-// to the box faces, so a voxel contributes over the same box as in SiddonRayCaster.
+// (midpoint rule over the part of the ray where interpolated values can be non-zero: the volume's content box grown
+// by half a voxel; the step is shortened so that a whole number of steps covers that part exactly). Beyond the
+// outermost voxel centres the edge voxels' values extend to the box faces, so a voxel contributes over the same box
+// as in SiddonRayCaster.
 
 #include <Eigen/Core>
 #include <memory>
@@ -38,6 +39,10 @@ class TrilinearRayCaster final : public DrrRenderer {
   double integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk, double length_mm) const;
 
   double m_step_mm = 1.0;
+  /// The part of the index box where a trilinear sample can be non-zero: the content box grown by half a voxel
+  /// (interpolation reaches one voxel beyond the outermost non-zero voxel centres), within the volume's box.
+  Eigen::Vector3d m_clipMin_ijk = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_clipMax_ijk = Eigen::Vector3d::Zero();
 };
 
 }  // namespace fct

@@ -24,6 +24,8 @@ int reportError(const std::string& message);
 void registerInfoCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct phantom`: writes the built-in procedural CT phantom to a NRRD or MetaImage file.
 void registerPhantomCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct drr`: renders DRRs of a CT for the views of a view file.
+void registerDrrCommand(CLI::App& app, CommandAction& action);
 
 
 }  // namespace fct::cli

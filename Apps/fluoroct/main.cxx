@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   CommandAction action;
   registerInfoCommand(app, action);
   registerPhantomCommand(app, action);
+  registerDrrCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

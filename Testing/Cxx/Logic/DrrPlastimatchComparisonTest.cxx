@@ -19,6 +19,7 @@
 #include "DicomSeriesReader.h"
 #include "DrrRendererFactory.h"
 #include "TestSupport.h"
+#include "VolumeFileIO.h"
 
 namespace {
 
@@ -190,6 +191,15 @@ TEST(DrrPlastimatchComparison, HeadPhantomMatchesPlastimatchExact) {
   if (!std::filesystem::exists(kPlastimatch)) GTEST_SKIP() << "plastimatch not installed at " << kPlastimatch;
   FCT_REQUIRE_DATA("ct/head_phantom_philips_bone");
   const auto ct = fct::DicomSeriesReader::read(fct::test::dataDir() / "ct/head_phantom_philips_bone");
+  ASSERT_TRUE(ct.ok()) << ct.error();
+  expectMatchesPlastimatch(ct.value());
+}
+
+TEST(DrrPlastimatchComparison, PelvisMatchesPlastimatchExact) {
+  if (!std::filesystem::exists(kPlastimatch)) GTEST_SKIP() << "plastimatch not installed at " << kPlastimatch;
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  // NIfTI (RAS on disk) comes back in LPS with a flipped direction; expectMatchesPlastimatch re-orders it to identity.
+  const auto ct = fct::VolumeFileIO::read(fct::test::dataDir() / "ct/pelvis_totalseg.nii.gz");
   ASSERT_TRUE(ct.ok()) << ct.error();
   expectMatchesPlastimatch(ct.value());
 }

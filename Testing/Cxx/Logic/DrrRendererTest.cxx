@@ -121,7 +121,7 @@ TEST_P(DrrRendererBehaviour, SameImageWithOneThreadAndWithAllThreads) {
   EXPECT_GT(*std::max_element(parallel.pixels.begin(), parallel.pixels.end()), 20.0f);
 }
 
-TEST_P(DrrRendererBehaviour, RaysMissingTheVolumeGiveZeros) {
+TEST_P(DrrRendererBehaviour, RaysMissingTheVolumeOrCrossingOnlyZerosGiveZeros) {
   const auto renderer = makeRenderer(m_ct);
   // Looking at a point 500 mm beside the CT, and looking away from it (CT behind the source).
   const fct::Camera beside = fct::Camera::lookingAt({500, 0, 0}, Eigen::Matrix3d::Identity(), 600.0, 1000.0, 40, 30, 1.0);
@@ -134,8 +134,12 @@ TEST_P(DrrRendererBehaviour, RaysMissingTheVolumeGiveZeros) {
                              T.linear() = flip;  // looks along -z, the CT is at +300 mm behind the source
                              return T;
                            }()).value();
-  for (const fct::Camera& camera : {beside, away}) {
-    const auto drr = renderer->render(camera, Eigen::Isometry3d::Identity());
+  fct::Volume air = m_ct;
+  air.voxels().assign(air.voxelCount(), 0.0f);
+  const auto airRenderer = makeRenderer(air);
+  for (const auto& [camera, r] : {std::pair{beside, renderer.get()}, std::pair{away, renderer.get()},
+                                  std::pair{m_camera, airRenderer.get()}}) {
+    const auto drr = r->render(camera, Eigen::Isometry3d::Identity());
     ASSERT_TRUE(drr.ok()) << drr.error();
     EXPECT_EQ(*std::max_element(drr.value().pixels.begin(), drr.value().pixels.end()), 0.0f);
     EXPECT_EQ(*std::min_element(drr.value().pixels.begin(), drr.value().pixels.end()), 0.0f);

@@ -40,6 +40,28 @@ TEST(DrrVolume, RawValuesAndGeometryAreThoseOfTheCt) {
   EXPECT_EQ(volume.value().boxMax_ijk(), Eigen::Vector3d(3.5, 0.5, 0.5));
 }
 
+TEST(DrrVolume, ContentBoxHoldsExactlyTheNonZeroVoxels) {
+  fct::Volume ct = fct::Volume::create({10, 8, 6}, {1.0, 1.0, 1.0}, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                       -1000.0f)
+                       .value();
+  ct.at(2, 5, 1) = 40.0f;
+  ct.at(7, 3, 4) = 200.0f;
+  const auto volume = fct::DrrVolume::create(ct);  // attenuation: air -> 0
+  ASSERT_TRUE(volume.ok()) << volume.error();
+  EXPECT_TRUE(volume.value().hasContent());
+  EXPECT_EQ(volume.value().contentBoxMin_ijk(), Eigen::Vector3d(1.5, 2.5, 0.5));
+  EXPECT_EQ(volume.value().contentBoxMax_ijk(), Eigen::Vector3d(7.5, 5.5, 4.5));
+
+  fct::DrrValueOptions raw;
+  raw.kind = fct::DrrValueKind::Raw;  // raw: air is -1000, so everything is content
+  const auto rawVolume = fct::DrrVolume::create(ct, raw);
+  EXPECT_EQ(rawVolume.value().contentBoxMin_ijk(), rawVolume.value().boxMin_ijk());
+  EXPECT_EQ(rawVolume.value().contentBoxMax_ijk(), rawVolume.value().boxMax_ijk());
+
+  ct.voxels().assign(ct.voxelCount(), -1024.0f);
+  EXPECT_FALSE(fct::DrrVolume::create(ct).value().hasContent());
+}
+
 TEST(DrrVolume, RejectsEmptyCtNonFiniteVoxelsAndBadWaterAttenuation) {
   EXPECT_FALSE(fct::DrrVolume::create(fct::Volume()).ok());
   fct::Volume ct = fourVoxelCt();

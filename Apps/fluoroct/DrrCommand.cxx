@@ -1,0 +1,148 @@
+// fluoroct drr: renders a DRR of a CT for every view of a view file (or one) and writes one image per view.
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "CliSupport.h"
+#include "CtLoader.h"
+#include "DrrRendererFactory.h"
+#include "DrrVolume.h"
+#include "ImageFileWriter.h"
+#include "PoseFile.h"
+#include "ViewFile.h"
+
+namespace fct::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct DrrCommandOptions {
+  std::string ct, views, pose, view, out;
+  std::string method = "siddon";
+  std::string values = "attenuation";
+  int level = 0;
+};
+
+/// A view name made safe for a file name: characters other than letters, digits, '-', '_' and '.' become '_'.
+std::string fileSafe(const std::string& name) {
+  std::string safe = name;
+  for (char& c : safe) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  }
+  return safe;
+}
+
+/// Writes one DRR in the format given by the extension (".nrrd", ".pfm", ".tif"/".tiff": float32; ".png": 16-bit,
+/// windowed from the image's minimum to its maximum).
+Status writeDrr(const FloatImage& image, const fs::path& path, const std::string& extension,
+                const Eigen::Vector2d& pixelSpacing_mm) {
+  if (extension == ".nrrd") return ImageFileWriter::writeNrrd2d(image, path, pixelSpacing_mm);
+  if (extension == ".pfm") return ImageFileWriter::writePfm(image, path);
+  if (extension == ".tif" || extension == ".tiff") return ImageFileWriter::writeTiff(image, path);
+  const auto [lo, hi] = std::minmax_element(image.pixels.begin(), image.pixels.end());
+  return ImageFileWriter::writePng16(image, path, *lo, *hi > *lo ? *hi : *lo + 1.0f);
+}
+
+int runDrr(const DrrCommandOptions& options) {
+  const fs::path out(options.out);
+  const std::string extension = out.extension().string();
+  if (extension != ".nrrd" && extension != ".pfm" && extension != ".tif" && extension != ".tiff" &&
+      extension != ".png") {
+    return reportError(fmt::format("--out '{}' must end in .nrrd, .pfm, .tif or .png", options.out));
+  }
+  if (!out.parent_path().empty() && !fs::is_directory(out.parent_path())) {
+    return reportError(fmt::format("output folder '{}' does not exist; create it first", out.parent_path().string()));
+  }
+  const auto method = DrrRendererFactory::parseMethod(options.method);
+  if (!method.ok()) return reportError(method.error());
+  const auto valueKind = DrrVolume::parseValueKind(options.values);
+  if (!valueKind.ok()) return reportError(valueKind.error());
+  if (options.level < 0) return reportError(fmt::format("--level must be 0 or more, got {}", options.level));
+
+  auto views = ViewFile::read(options.views);
+  if (!views.ok()) return reportError(views.error());
+  for (const auto& warning : views.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  std::vector<ViewSpec> selected = views.value();
+  if (!options.view.empty()) {
+    std::erase_if(selected, [&](const ViewSpec& v) { return v.name != options.view; });
+    if (selected.empty()) {
+      std::string names;
+      for (const auto& v : views.value()) names += (names.empty() ? "" : ", ") + v.name;
+      return reportError(fmt::format("view '{}' is not in {}; its views are: {}", options.view, options.views, names));
+    }
+  }
+  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();
+  if (!options.pose.empty()) {
+    const auto pose = PoseFile::read(options.pose);
+    if (!pose.ok()) return reportError(pose.error());
+    T_world_from_ct = pose.value();
+  }
+
+  const auto ct = CtLoader::load(options.ct);
+  if (!ct.ok()) return reportError(ct.error());
+  for (const auto& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  DrrValueOptions valueOptions;
+  valueOptions.kind = valueKind.value();
+  auto drrVolume = DrrVolume::create(ct.value(), valueOptions);
+  if (!drrVolume.ok()) return reportError(drrVolume.error());
+  DrrRendererOptions rendererOptions;
+  rendererOptions.method = method.value();
+  const auto renderer =
+      DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(drrVolume).value()), rendererOptions);
+  if (!renderer.ok()) return reportError(renderer.error());
+
+  // Render every view before writing any file, so a view that cannot be rendered leaves nothing behind.
+  std::vector<FloatImage> images(selected.size());
+  std::vector<double> seconds(selected.size());
+  for (std::size_t n = 0; n < selected.size(); ++n) {
+    const auto start = std::chrono::steady_clock::now();
+    const Status rendered = renderer.value()->render(selected[n].camera, T_world_from_ct, options.level, images[n]);
+    if (!rendered.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, rendered.error()));
+    seconds[n] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  const fs::path prefix = out.parent_path() / out.stem();
+  for (std::size_t n = 0; n < selected.size(); ++n) {
+    const fs::path path = fs::path(prefix.string() + "_" + fileSafe(selected[n].name) + extension);
+    const Eigen::Vector2d spacing_mm = selected[n].camera.downsampled(options.level).intrinsics().pixelSpacing_mm;
+    const Status written = writeDrr(images[n], path, extension, spacing_mm);
+    if (!written.ok()) return reportError(written.error());
+    const auto [lo, hi] = std::minmax_element(images[n].pixels.begin(), images[n].pixels.end());
+    fmt::print("wrote {}: {} x {} px, {} {} DRR, level {}, values {:.4g}..{:.4g}, {:.3f} s\n", path.string(),
+               images[n].cols, images[n].rows, options.method, options.values, options.level, *lo, *hi, seconds[n]);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void registerDrrCommand(CLI::App& app, CommandAction& action) {
+  auto options = std::make_shared<DrrCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "drr", "Render digitally reconstructed radiographs of a CT for the views of a view file; writes "
+             "PREFIX_<view name>.<ext> per view (float32 .nrrd/.pfm/.tif, or a min-max windowed 16-bit .png)");
+  command->add_option("--ct", options->ct, "CT volume file (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd) or DICOM folder")
+      ->required();
+  command->add_option("--views", options->views, "View file (JSON) with the calibrated cameras")->required();
+  command->add_option("--pose", options->pose, "Pose file with T_world_from_ct (default: identity)");
+  command->add_option("--view", options->view, "Render only the view with this name");
+  command->add_option("--method", options->method, "raycast (trilinear sampling) or siddon (exact)")
+      ->capture_default_str();
+  command->add_option("--values", options->values,
+                      "attenuation (integral of mu from HU, dimensionless) or raw (integral of voxel value, value*mm)")
+      ->capture_default_str();
+  command->add_option("--level", options->level, "Pyramid level: detector downsampled by 2^level per axis")
+      ->capture_default_str();
+  command->add_option("--out", options->out, "Output prefix and format, e.g. out/drr.nrrd -> out/drr_<view>.nrrd")
+      ->required();
+  command->callback([&action, options] { action = [options] { return runDrr(*options); }; });
+}
+
+}  // namespace fct::cli
