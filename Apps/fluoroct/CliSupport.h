@@ -26,6 +26,10 @@ void registerInfoCommand(CLI::App& app, CommandAction& action);
 void registerPhantomCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct drr`: renders DRRs of a CT for the views of a view file.
 void registerDrrCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct views`: writes a view file of standard C-arm views around a CT's centre.
+void registerViewsCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct simulate`: writes simulated X-ray images of a CT at a pose, with a view file and the true pose.
+void registerSimulateCommand(CLI::App& app, CommandAction& action);
 
 
 }  // namespace fct::cli

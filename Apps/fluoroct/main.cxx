@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   registerInfoCommand(app, action);
   registerPhantomCommand(app, action);
   registerDrrCommand(app, action);
+  registerViewsCommand(app, action);
+  registerSimulateCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
