@@ -1,6 +1,9 @@
 #pragma once
-// XrayImage: one fluoroscopic / radiographic frame as float pixels in the MONOCHROME2 sense
-// (bright = more signal at the detector), with what was known about its origin and geometry.
+// XrayImage: one fluoroscopic / radiographic frame as float pixels in the MONOCHROME2 display sense (higher value is
+// displayed brighter; MONOCHROME1 files are inverted on import), with what was known about its origin and geometry.
+// Note the physical polarity differs by modality: raw fluoroscopy (XA, RF) is bright where more signal reaches the
+// detector (bone dark), while processed radiographs (CR, DX) are usually stored with bone bright. The registration's
+// X-ray preparation decides the polarity; Core does not guess it.
 
 #include <cstdint>
 #include <optional>

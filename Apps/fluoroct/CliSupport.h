@@ -20,5 +20,8 @@ int reportError(const std::string& message);
 // Each command file provides a register function: it adds its subcommand to `app` and, when the subcommand is
 // chosen, stores its action in `action` (run after parsing).
 
+/// `fluoroct phantom`: writes the built-in procedural CT phantom to a NRRD or MetaImage file.
+void registerPhantomCommand(CLI::App& app, CommandAction& action);
+
 
 }  // namespace fct::cli

@@ -1,0 +1,70 @@
+#pragma once
+// DrrVolume: the CT prepared once for DRR rendering: per-voxel values whose line integral is the DRR
+// (attenuation µ in 1/mm, or the raw voxel value), on the CT's voxel grid, with the CT index <-> CT mm maps.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string_view>
+
+#include "Result.h"
+#include "Volume.h"
+
+namespace fct {
+
+/// What a DRR integrates along each ray.
+enum class DrrValueKind {
+  /// µ = µ_water · (1 + HU / 1000) in 1/mm, HU <= -1000 (air and below) clamped to 0; the DRR ∫µ dl is dimensionless.
+  Attenuation,
+  /// The voxel value as stored (HU for a CT, negative in air); the DRR ∫value dl is in value·mm.
+  Raw,
+};
+
+/// How voxel values become DRR values.
+struct DrrValueOptions {
+  /// Linear attenuation coefficient of water at 60 keV, the effective energy of a ~100-120 kVp fluoroscopy beam:
+  /// µ/ρ = 0.2059 cm²/g (NIST XCOM / Hubbell & Seltzer, NIST Standard Reference Database 126, liquid water), ρ = 1 g/cm³.
+  static constexpr double kWaterAttenuationAt60keV_per_mm = 0.02059;
+
+  DrrValueKind kind = DrrValueKind::Attenuation;
+  double waterAttenuation_per_mm = kWaterAttenuationAt60keV_per_mm;  ///< µ_water used by Attenuation
+};
+
+/// The per-voxel DRR values of a CT (float, i fastest) and its geometry. Voxel (i,j,k) is the box of one spacing
+/// around its centre, so the volume's extent in index space is [-0.5, dims - 0.5] per axis.
+class DrrVolume {
+ public:
+  DrrVolume() = default;
+
+  /// Converts a CT once. Fails on an empty volume, non-finite voxels, or a non-positive or non-finite µ_water.
+  static Result<DrrVolume> create(const Volume& ct, const DrrValueOptions& options = {});
+
+  /// Parses "attenuation" or "raw"; the error lists the accepted names.
+  static Result<DrrValueKind> parseValueKind(std::string_view name);
+  /// The name parseValueKind() accepts for `kind`.
+  static std::string_view valueKindName(DrrValueKind kind);
+
+  /// The DRR values on the CT grid: 1/mm for Attenuation, the CT's unit for Raw. Geometry equals the CT's.
+  const Volume& values() const { return m_values; }
+  /// Which values were computed and with which µ_water.
+  const DrrValueOptions& options() const { return m_options; }
+  /// Voxel count along i, j, k.
+  const Eigen::Vector3i& dims() const { return m_values.dims(); }
+  /// Contiguous voxel values, i fastest, then j, then k.
+  const float* data() const { return m_values.voxels().data(); }
+  /// Map from CT physical mm (LPS) to continuous voxel index.
+  const Eigen::Affine3d& T_ijk_from_ct() const { return m_T_ijk_from_ct; }
+  /// Map from continuous voxel index to CT physical mm (LPS).
+  const Eigen::Affine3d& T_ct_from_ijk() const { return m_T_ct_from_ijk; }
+  /// Lower corner of the voxel boxes in index space: (-0.5, -0.5, -0.5).
+  Eigen::Vector3d boxMin_ijk() const { return Eigen::Vector3d::Constant(-0.5); }
+  /// Upper corner of the voxel boxes in index space: dims - 0.5.
+  Eigen::Vector3d boxMax_ijk() const { return dims().cast<double>().array() - 0.5; }
+
+ private:
+  Volume m_values;
+  DrrValueOptions m_options;
+  Eigen::Affine3d m_T_ijk_from_ct = Eigen::Affine3d::Identity();
+  Eigen::Affine3d m_T_ct_from_ijk = Eigen::Affine3d::Identity();
+};
+
+}  // namespace fct

@@ -1,0 +1,32 @@
+#pragma once
+// SeededRandom: reproducible random numbers for the searches. std::mt19937's output sequence is fixed by the
+// standard, but std::uniform_real_distribution / normal_distribution are not, so the conversions are our own:
+// the same seed gives the same numbers with every compiler and standard library.
+
+#include <cstdint>
+#include <random>
+
+namespace fct {
+
+/// A seeded generator of uniform and Gaussian numbers.
+class SeededRandom {
+ public:
+  /// A generator started from `seed`.
+  explicit SeededRandom(std::uint32_t seed) : m_engine(seed) {}
+
+  /// Uniform in the open interval (0, 1).
+  double uniform01();
+  /// Uniform in [low, high).
+  double uniform(double low, double high) { return low + (high - low) * uniform01(); }
+  /// Uniform integer in [0, count); count must be > 0.
+  int index(int count);
+  /// Standard normal (Box–Muller).
+  double normal();
+
+ private:
+  std::mt19937 m_engine;
+  bool m_hasSpare = false;
+  double m_spare = 0.0;
+};
+
+}  // namespace fct
