@@ -53,10 +53,10 @@ std::size_t TransgraphLayout::rayCount() const {
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> TransgraphLayout::rayEndpoints_ct_mm(int is, int it, int ids,
                                                                                 int idt) const {
-  const double s = min_mm[0] + spacing_mm * is;
-  const double t = min_mm[1] + spacing_mm * it;
-  const double ds = min_mm[2] + spacing_mm * ids;
-  const double dt = min_mm[3] + spacing_mm * idt;
+  const double s = min_mm[0] + step_mm[0] * is;
+  const double t = min_mm[1] + step_mm[1] * it;
+  const double ds = min_mm[2] + step_mm[2] * ids;
+  const double dt = min_mm[3] + step_mm[3] * idt;
   return {origin_ct_mm + R_ct_from_plane * Eigen::Vector3d(s - 0.5 * ds, t - 0.5 * dt, front_w_mm),
           origin_ct_mm + R_ct_from_plane * Eigen::Vector3d(s + 0.5 * ds, t + 0.5 * dt, back_w_mm)};
 }
@@ -85,6 +85,10 @@ Result<TransgraphLayout> Transgraph::plan(const Volume& ct, const Camera& view, 
   if (!std::isfinite(parameters.spacing_mm) || parameters.spacing_mm <= 0.0) {
     return fail(fmt::format("Transgraph plane spacing must be a positive number of mm, got {}", parameters.spacing_mm));
   }
+  if (!std::isfinite(parameters.offsetSpacing_mm) || parameters.offsetSpacing_mm < 0.0) {
+    return fail(fmt::format("Transgraph offset spacing must be >= 0 mm (0: twice the plane spacing), got {}",
+                            parameters.offsetSpacing_mm));
+  }
   if (!std::isfinite(parameters.range.rotation_deg) || parameters.range.rotation_deg < 0.0 ||
       parameters.range.rotation_deg > 60.0 || !std::isfinite(parameters.range.translation_mm) ||
       parameters.range.translation_mm < 0.0) {
@@ -99,7 +103,9 @@ Result<TransgraphLayout> Transgraph::plan(const Volume& ct, const Camera& view, 
   if (!pose) return fail(pose.error());
 
   TransgraphLayout layout;
-  layout.spacing_mm = parameters.spacing_mm;
+  const double offsetSpacing_mm =
+      parameters.offsetSpacing_mm > 0.0 ? parameters.offsetSpacing_mm : 2.0 * parameters.spacing_mm;
+  layout.step_mm = Eigen::Vector4d(parameters.spacing_mm, parameters.spacing_mm, offsetSpacing_mm, offsetSpacing_mm);
   layout.origin_ct_mm = ct.centre_lps_mm();
   layout.R_ct_from_plane = T_world_from_ct.linear().transpose() * view.T_world_from_camera().linear();
   const Eigen::Matrix3d R_plane_from_ct = layout.R_ct_from_plane.transpose();
@@ -172,20 +178,22 @@ Result<TransgraphLayout> Transgraph::plan(const Volume& ct, const Camera& view, 
     }
   }
 
-  const double h = parameters.spacing_mm;
   double rays = 1.0;
   for (int a = 0; a < 4; ++a) {
+    const double h = layout.step_mm[a];
     layout.min_mm[a] = lo[a] - h;
     const double n = std::ceil((hi[a] + h - layout.min_mm[a]) / h) + 1.0;
     rays *= n;
     layout.counts[a] = n < 2e9 ? static_cast<int>(n) : std::numeric_limits<int>::max();
   }
   if (rays > static_cast<double>(parameters.maxRays)) {
-    const double fittingSpacing = std::ceil(10.0 * h * std::pow(rays / parameters.maxRays, 0.25)) / 10.0;
-    return fail(fmt::format("a Transgraph at {} mm spacing for ±{} deg, ±{} mm would hold {:.0f} M rays ({:.1f} GB), "
-                            "more than the limit of {} M; use a spacing of about {} mm or a narrower range",
-                            h, parameters.range.rotation_deg, parameters.range.translation_mm, rays / 1e6,
-                            rays * sizeof(float) / 1e9, parameters.maxRays / 1'000'000, fittingSpacing));
+    const double scale = std::pow(rays / parameters.maxRays, 0.25);
+    return fail(fmt::format("a Transgraph at {} mm spacing ({} mm offsets) for ±{} deg, ±{} mm would hold {:.0f} M rays "
+                            "({:.1f} GB), more than the limit of {} M; use a spacing of about {:.1f} mm or a narrower "
+                            "range",
+                            layout.step_mm[0], layout.step_mm[2], parameters.range.rotation_deg,
+                            parameters.range.translation_mm, rays / 1e6, rays * sizeof(float) / 1e9,
+                            parameters.maxRays / 1'000'000, std::ceil(10.0 * layout.step_mm[0] * scale) / 10.0));
   }
   return layout;
 }
@@ -291,9 +299,9 @@ Result<Transgraph> Transgraph::fromTable(const TransgraphLayout& layout, std::ve
                               layout.counts[a]));
     }
   }
-  if (!(layout.spacing_mm > 0.0) || !(layout.back_w_mm > layout.front_w_mm)) {
-    return fail(fmt::format("Transgraph layout is degenerate (spacing {} mm, planes at {} and {} mm)",
-                            layout.spacing_mm, layout.front_w_mm, layout.back_w_mm));
+  if (!(layout.step_mm.minCoeff() > 0.0) || !(layout.back_w_mm > layout.front_w_mm)) {
+    return fail(fmt::format("Transgraph layout is degenerate (steps {} mm, planes at {} and {} mm)",
+                            layout.step_mm.minCoeff(), layout.front_w_mm, layout.back_w_mm));
   }
   if (table.size() != layout.rayCount()) {
     return fail(fmt::format("Transgraph table holds {} values but its layout needs {}", table.size(),
@@ -310,7 +318,7 @@ Result<Transgraph> Transgraph::fromTable(const TransgraphLayout& layout, std::ve
 // mapping in the plane frame, so that a pixel costs one 3x3 product, two divisions and 16 table reads.
 struct Transgraph::PixelSampler {
   const Transgraph* transgraph = nullptr;
-  int cols = 0, rows = 0;
+  int cols = 0;
   Eigen::Vector3d source_ct_mm;
   Eigen::Matrix3d R_ct_from_camera;
   Eigen::Vector3d source_plane_mm;
@@ -345,11 +353,10 @@ float Transgraph::interpolate(const Eigen::Vector3d& source_plane_mm, const Eige
   const double slab = L.back_w_mm - L.front_w_mm;
   const double coordinates[4] = {source_plane_mm.x() + toMid * r, source_plane_mm.y() + toMid * q, slab * r,
                                  slab * q};
-  const double invSpacing = 1.0 / L.spacing_mm;
   int index[4];
   double frac[4];
   for (int a = 0; a < 4; ++a) {
-    const double g = (coordinates[a] - L.min_mm[a]) * invSpacing;
+    const double g = (coordinates[a] - L.min_mm[a]) / L.step_mm[a];
     if (!(g >= 0.0 && g <= L.counts[a] - 1)) return std::nanf("");
     index[a] = std::min(static_cast<int>(g), L.counts[a] - 2);
     frac[a] = g - index[a];
@@ -385,23 +392,11 @@ float Transgraph::integrate(const Eigen::Vector3d& source_ct_mm, const Eigen::Ve
   return v;
 }
 
-Result<Transgraph::PixelSampler> Transgraph::sampler(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
-                                                     int level) const {
-  if (m_table.empty()) return fail("the Transgraph is empty; build or load it before rendering");
-  if (level < 0 || level > 12) return fail(fmt::format("pyramid level must be 0..12, got {}", level));
-  if (auto ok = validateCamera(camera, "the DRR camera"); !ok) return fail(ok.error());
-  auto pose = RigidPose::validated(T_world_from_ct.matrix(), "pose T_world_from_ct");
-  if (!pose) return fail(pose.error());
-  const Camera levelCamera = camera.downsampled(level);
+Transgraph::PixelSampler Transgraph::sampler(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct) const {
   const auto& in = levelCamera.intrinsics();
-  if (in.cols <= 0 || in.rows <= 0) {
-    return fail(fmt::format("pyramid level {} of a {} x {} detector has no pixels", level, camera.intrinsics().cols,
-                            camera.intrinsics().rows));
-  }
   PixelSampler s;
   s.transgraph = this;
   s.cols = in.cols;
-  s.rows = in.rows;
   const Eigen::Isometry3d T_ct_from_camera = T_world_from_ct.inverse() * levelCamera.T_world_from_camera();
   s.source_ct_mm = T_ct_from_camera.translation();
   s.R_ct_from_camera = T_ct_from_camera.linear();
@@ -411,55 +406,25 @@ Result<Transgraph::PixelSampler> Transgraph::sampler(const Camera& camera, const
   s.principalPoint_px = in.principalPoint_px;
   s.pixelSpacing_mm = in.pixelSpacing_mm;
   s.sourceToDetector_mm = in.sourceToDetector_mm;
-  s.sourceInFront = s.source_plane_mm.z() < m_layout.front_w_mm;
+  s.sourceInFront = !m_table.empty() && s.source_plane_mm.z() < m_layout.front_w_mm;
   return s;
 }
 
-Status Transgraph::render(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct, int level,
-                          FloatImage& out) const {
-  auto made = sampler(camera, T_world_from_ct, level);
-  if (!made) return fail(made.error());
-  const PixelSampler& s = made.value();
-  out.cols = s.cols;
-  out.rows = s.rows;
-  out.pixels.resize(static_cast<std::size_t>(s.cols) * s.rows);
+void Transgraph::integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct,
+                                 const std::int32_t* pixels, std::size_t count, float* values) const {
+  const PixelSampler s = sampler(levelCamera, T_world_from_ct);
   std::atomic<std::size_t> fallbacks{0};
-  tbb::parallel_for(tbb::blocked_range<int>(0, s.rows), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 256), [&](const tbb::blocked_range<std::size_t>& range) {
     std::size_t local = 0;
-    for (int row = range.begin(); row != range.end(); ++row) {
-      float* line = out.pixels.data() + static_cast<std::size_t>(row) * s.cols;
-      for (int col = 0; col < s.cols; ++col) line[col] = s.value(col, row, local);
+    for (std::size_t n = range.begin(); n != range.end(); ++n) {
+      const std::int64_t index = pixels ? pixels[n] : static_cast<std::int64_t>(n);
+      const int row = static_cast<int>(index / s.cols);
+      const int col = static_cast<int>(index - static_cast<std::int64_t>(row) * s.cols);
+      values[n] = s.value(col, row, local);
     }
     fallbacks.fetch_add(local, std::memory_order_relaxed);
   });
   m_lastFallbackRays.store(fallbacks.load(), std::memory_order_relaxed);
-  return Ok{};
-}
-
-Status Transgraph::renderPixels(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct, int level,
-                                const PixelIndexList& pixels, std::vector<float>& values) const {
-  auto made = sampler(camera, T_world_from_ct, level);
-  if (!made) return fail(made.error());
-  const PixelSampler& s = made.value();
-  const std::int64_t pixelCount = static_cast<std::int64_t>(s.cols) * s.rows;
-  for (std::int32_t index : pixels) {
-    if (index < 0 || index >= pixelCount) {
-      return fail(fmt::format("pixel index {} is outside the {} x {} detector of level {}", index, s.cols, s.rows,
-                              level));
-    }
-  }
-  values.resize(pixels.size());
-  std::atomic<std::size_t> fallbacks{0};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::size_t local = 0;
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        values[i] = s.value(pixels[i] % s.cols, pixels[i] / s.cols, local);
-                      }
-                      fallbacks.fetch_add(local, std::memory_order_relaxed);
-                    });
-  m_lastFallbackRays.store(fallbacks.load(), std::memory_order_relaxed);
-  return Ok{};
 }
 
 }  // namespace fct

@@ -7,9 +7,10 @@
 // direction. The front plane w = front_w_mm and the back plane w = back_w_mm enclose the CT's bounding box. A ray
 // from (s1, t1) on the front plane to (s2, t2) on the back plane is stored by its mid-plane point
 // (s, t) = ((s1 + s2) / 2, (t1 + t2) / 2) and its offset (ds, dt) = (s2 - s1, t2 - t1); each of the four coordinates
-// is sampled every spacing_mm. The offset keeps only the band of rays that a C-arm can produce (several times fewer
+// is sampled on a regular grid. The offset keeps only the band of rays that a C-arm can produce (several times fewer
 // than the full (s1, t1, s2, t2) box), and the mid-plane point makes an offset step pivot the ray about the CT's
-// middle, which measured ~20 % less interpolation error than pivoting about the front plane.
+// middle, which measured ~20 % less interpolation error than pivoting about the front plane. An offset step moves the
+// ray inside the CT at most half as far as a step of (s, t), so the offsets are sampled twice as coarsely by default.
 // The table value of a ray is the integral from its front-plane point to its back-plane point, which equals the
 // integral along the whole line because the CT lies between the planes.
 
@@ -17,6 +18,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstdint>
 #include <atomic>
 #include <cstddef>
 #include <filesystem>
@@ -25,7 +27,6 @@
 #include <vector>
 
 #include "Camera.h"
-#include "FloatImage.h"
 #include "ProgressMonitor.h"
 #include "Result.h"
 #include "Volume.h"
@@ -41,7 +42,8 @@ struct TransgraphRange {
 
 /// Build parameters of a Transgraph.
 struct TransgraphParameters {
-  double spacing_mm = 2.0;           ///< sampling step of s, t, ds, dt in mm (the paper's ~15 M rays is ~60 per axis)
+  double spacing_mm = 2.0;           ///< sampling step of the mid-plane point (s, t), mm
+  double offsetSpacing_mm = 0.0;     ///< sampling step of the offset (ds, dt), mm; 0 = 2 x spacing_mm
   TransgraphRange range;             ///< validity range around the expected pose
   double planeMargin_mm = 1.0;       ///< gap between the CT's bounding box and each plane
   std::size_t maxRays = 250'000'000; ///< refuse tables larger than this (4 bytes per ray)
@@ -55,7 +57,7 @@ struct TransgraphLayout {
   double front_w_mm = 0.0;                                          ///< w of the front plane (source side)
   double back_w_mm = 0.0;                                           ///< w of the back plane (detector side)
   Eigen::Vector4d min_mm = Eigen::Vector4d::Zero();                 ///< first sample of (s, t, ds, dt) in mm
-  double spacing_mm = 1.0;                                          ///< sample step of all four coordinates, mm
+  Eigen::Vector4d step_mm = Eigen::Vector4d::Ones();                ///< sample step of (s, t, ds, dt), mm
   std::array<int, 4> counts{0, 0, 0, 0};                            ///< samples along s, t, ds, dt
 
   /// Number of stored rays (product of counts).
@@ -107,22 +109,20 @@ class Transgraph {
   static Result<Transgraph> fromTable(const TransgraphLayout& layout, std::vector<float> table,
                                       RayIntegrator integrator);
 
-  /// Renders the DRR of `camera` downsampled to pyramid `level` (Camera::downsampled) at pose T_world_from_ct into
-  /// `out` (resized to the level's detector; its buffer is reused when the size matches). Rays outside the table use
-  /// the integrator (see lastFallbackRayCount()). Fails on an empty Transgraph, a bad camera or a negative level.
-  Status render(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct, int level, FloatImage& out) const;
+  /// Integrates the rays of `count` pixels of `levelCamera` (already downsampled to the wanted pyramid level) for the
+  /// CT at pose T_world_from_ct: pixel n is pixels[n] (linear index row * cols + col) or, when `pixels` is null,
+  /// linear index n; writes values[n]. Rays outside the table use the integrator (see lastFallbackRayCount()).
+  /// Parallel and deterministic. Preconditions (checked by DrrRenderer): a non-empty Transgraph, a valid camera and
+  /// pose, valid indices.
+  void integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct,
+                       const std::int32_t* pixels, std::size_t count, float* values) const;
 
-  /// Renders only the listed pixels (linear indices row * cols + col of the level's detector) into values[i] for
-  /// pixels[i] (values is resized; its buffer is reused). Fails like render() or on an index outside the detector.
-  Status renderPixels(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct, int level,
-                      const PixelIndexList& pixels, std::vector<float>& values) const;
-
-  /// The integral of one CT-frame ray (source point, direction), interpolated from the table; falls back to the
-  /// integrator from the source to `end_ct_mm` when the ray is outside the table. Sets *usedFallback if given.
+  /// The integral along the line through source_ct_mm and end_ct_mm (CT frame, mm), interpolated from the table;
+  /// when the ray is outside the table, the integrator's value from the source to end_ct_mm. Sets *usedFallback.
   float integrate(const Eigen::Vector3d& source_ct_mm, const Eigen::Vector3d& end_ct_mm,
                   bool* usedFallback = nullptr) const;
 
-  /// Number of rays of the last render() / renderPixels() that were outside the table and used the integrator.
+  /// Number of rays of the last integratePixels() that were outside the table and used the integrator.
   std::size_t lastFallbackRayCount() const { return m_lastFallbackRays.load(std::memory_order_relaxed); }
 
   /// The table's geometry and sampling.
@@ -138,7 +138,7 @@ class Transgraph {
 
  private:
   struct PixelSampler;
-  Result<PixelSampler> sampler(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct, int level) const;
+  PixelSampler sampler(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct) const;
   // Quadrilinear table value of a plane-frame ray, NaN when the ray is outside the table.
   float interpolate(const Eigen::Vector3d& source_plane_mm, const Eigen::Vector3d& direction_plane) const;
 

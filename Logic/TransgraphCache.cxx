@@ -106,7 +106,7 @@ std::vector<char> headerBytes(std::uint64_t key, const TransgraphLayout& layout)
   w.put(layout.front_w_mm);
   w.put(layout.back_w_mm);
   w.putDoubles(layout.min_mm.data(), 4);
-  w.put(layout.spacing_mm);
+  w.putDoubles(layout.step_mm.data(), 4);
   for (int c : layout.counts) w.put(static_cast<std::int32_t>(c));
   w.put(static_cast<std::uint64_t>(layout.rayCount()));
   return w.bytes();
@@ -117,7 +117,7 @@ bool sameLayout(const TransgraphLayout& a, const TransgraphLayout& b) {
   return a.counts == b.counts && (a.origin_ct_mm - b.origin_ct_mm).cwiseAbs().maxCoeff() <= tol &&
          (a.R_ct_from_plane - b.R_ct_from_plane).cwiseAbs().maxCoeff() <= tol &&
          std::abs(a.front_w_mm - b.front_w_mm) <= tol && std::abs(a.back_w_mm - b.back_w_mm) <= tol &&
-         (a.min_mm - b.min_mm).cwiseAbs().maxCoeff() <= tol && std::abs(a.spacing_mm - b.spacing_mm) <= tol;
+         (a.min_mm - b.min_mm).cwiseAbs().maxCoeff() <= tol && (a.step_mm - b.step_mm).cwiseAbs().maxCoeff() <= tol;
 }
 
 }  // namespace
@@ -153,6 +153,7 @@ std::uint64_t TransgraphCache::key(const Volume& ct, const Camera& view, const E
   h.matrix(view.T_world_from_camera().matrix().data(), 16);
   h.matrix(T_world_from_ct.matrix().data(), 16);
   h.value(parameters.spacing_mm);
+  h.value(parameters.offsetSpacing_mm);
   h.value(parameters.range.rotation_deg);
   h.value(parameters.range.translation_mm);
   h.value(parameters.planeMargin_mm);
@@ -232,7 +233,7 @@ Result<TransgraphCache::Entry> TransgraphCache::load(const std::filesystem::path
   r.get(layout.front_w_mm);
   r.get(layout.back_w_mm);
   r.getDoubles(layout.min_mm.data(), 4);
-  r.get(layout.spacing_mm);
+  r.getDoubles(layout.step_mm.data(), 4);
   for (std::int32_t& c : counts) r.get(c);
   if (!r.get(rays)) return fail("cannot read the header");
   if (version != kVersion) return fail(fmt::format("format version {} is not the supported {}", version, kVersion));

@@ -6,10 +6,13 @@
 #include <random>
 
 #include "Camera.h"
+#include "DrrVolume.h"
 #include "RigidPose.h"
+#include "SiddonRayCaster.h"
 #include "TestSupport.h"
 #include "Transgraph.h"
 #include "TransgraphCache.h"
+#include "TransgraphRenderer.h"
 #include "Volume.h"
 
 namespace {
@@ -18,6 +21,7 @@ using fct::Camera;
 using fct::Transgraph;
 using fct::TransgraphCache;
 using fct::TransgraphParameters;
+using fct::TransgraphRenderer;
 
 // A uniform ellipsoid with axes along the CT frame's axes; the integral of a segment is its chord length times value.
 struct Ellipsoid {
@@ -89,11 +93,17 @@ struct Scene {
   }
 };
 
-const Transgraph& sceneTransgraph() {
+// The scene's table, filled with the closed-form integrator, behind the DrrRenderer interface (the volume only
+// provides geometry; every value comes from the Transgraph).
+const TransgraphRenderer& sceneRenderer() {
   static const Scene scene;
-  static const Transgraph transgraph =
-      Transgraph::build(scene.ct, scene.view, scene.T_expected, scene.parameters, scene.ellipsoid.integrator()).value();
-  return transgraph;
+  static const std::unique_ptr<TransgraphRenderer> renderer =
+      TransgraphRenderer::fromTransgraph(
+          std::make_shared<const fct::DrrVolume>(fct::DrrVolume::create(scene.ct).value()),
+          Transgraph::build(scene.ct, scene.view, scene.T_expected, scene.parameters, scene.ellipsoid.integrator())
+              .value())
+          .value();
+  return *renderer;
 }
 
 // Checks every pixel whose ray passes through the ellipsoid's interior against the closed form; returns the count.
@@ -114,7 +124,7 @@ int expectInteriorPixelsMatch(const Scene& scene, const Camera& camera, const Ei
 
 TEST(Transgraph, PlansTableAroundTheCtAndReportsSize) {
   const Scene scene;
-  const Transgraph& transgraph = sceneTransgraph();
+  const Transgraph& transgraph = sceneRenderer().transgraph();
   const auto& layout = transgraph.layout();
   EXPECT_EQ(transgraph.rayCount(), layout.rayCount());
   EXPECT_EQ(transgraph.memory_bytes(), 4 * layout.rayCount());
@@ -146,7 +156,7 @@ TEST(Transgraph, PlansTableAroundTheCtAndReportsSize) {
 
 TEST(Transgraph, MatchesAnalyticEllipsoidInsideValidityRange) {
   const Scene scene;
-  const Transgraph& transgraph = sceneTransgraph();
+  const TransgraphRenderer& renderer = sceneRenderer();
   const double r = scene.parameters.range.rotation_deg, t = scene.parameters.range.translation_mm;
   std::mt19937 random(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -159,19 +169,20 @@ TEST(Transgraph, MatchesAnalyticEllipsoidInsideValidityRange) {
   }
   for (const auto& pose : poses) {
     fct::FloatImage drr;
-    ASSERT_TRUE(transgraph.render(scene.view, pose, 0, drr).ok());
-    EXPECT_EQ(transgraph.lastFallbackRayCount(), 0u) << "every ray of a pose inside the range is in the table";
+    ASSERT_TRUE(renderer.render(scene.view, pose, 0, drr).ok());
+    EXPECT_EQ(renderer.lastFallbackRayCount(), 0u) << "every ray of a pose inside the range is in the table";
     EXPECT_GT(expectInteriorPixelsMatch(scene, scene.view, pose, drr, 0.01), 500);
   }
 }
 
 TEST(Transgraph, FallsBackToIntegratorOutsideValidityRange) {
   const Scene scene;
-  const Transgraph& transgraph = sceneTransgraph();
+  const TransgraphRenderer& renderer = sceneRenderer();
+  const Transgraph& transgraph = renderer.transgraph();
   const Eigen::Isometry3d pose = scene.poseWithin(Eigen::Vector3d(0.0, 35.0, 0.0), Eigen::Vector3d(40.0, 0.0, 0.0));
   fct::FloatImage drr;
-  ASSERT_TRUE(transgraph.render(scene.view, pose, 0, drr).ok());
-  const std::size_t fallbacks = transgraph.lastFallbackRayCount();
+  ASSERT_TRUE(renderer.render(scene.view, pose, 0, drr).ok());
+  const std::size_t fallbacks = renderer.lastFallbackRayCount();
   EXPECT_GT(fallbacks, 0u);
   std::size_t counted = 0;
   for (int row = 0; row < drr.rows; ++row) {
@@ -191,12 +202,12 @@ TEST(Transgraph, FallsBackToIntegratorOutsideValidityRange) {
 
 TEST(Transgraph, LevelAndPixelListRendersEqualFullRenderPixels) {
   const Scene scene;
-  const Transgraph& transgraph = sceneTransgraph();
+  const TransgraphRenderer& renderer = sceneRenderer();
   const Eigen::Isometry3d pose = scene.poseWithin(Eigen::Vector3d(2.0, -3.0, 1.0), Eigen::Vector3d(4.0, 5.0, -6.0));
   for (int level : {1, 2}) {
     fct::FloatImage levelDrr, fullOfLevelCamera;
-    ASSERT_TRUE(transgraph.render(scene.view, pose, level, levelDrr).ok());
-    ASSERT_TRUE(transgraph.render(scene.view.downsampled(level), pose, 0, fullOfLevelCamera).ok());
+    ASSERT_TRUE(renderer.render(scene.view, pose, level, levelDrr).ok());
+    ASSERT_TRUE(renderer.render(scene.view.downsampled(level), pose, 0, fullOfLevelCamera).ok());
     EXPECT_EQ(levelDrr.cols, 80 >> level);
     EXPECT_EQ(levelDrr.rows, 60 >> level);
     EXPECT_EQ(levelDrr.pixels, fullOfLevelCamera.pixels);
@@ -204,14 +215,14 @@ TEST(Transgraph, LevelAndPixelListRendersEqualFullRenderPixels) {
     fct::PixelIndexList pixels;
     for (int i = 0; i < levelDrr.cols * levelDrr.rows; i += 7) pixels.push_back(i);
     std::vector<float> values;
-    ASSERT_TRUE(transgraph.renderPixels(scene.view, pose, level, pixels, values).ok());
+    ASSERT_TRUE(renderer.renderPixels(scene.view, pose, level, pixels, values).ok());
     ASSERT_EQ(values.size(), pixels.size());
     for (std::size_t i = 0; i < pixels.size(); ++i) EXPECT_EQ(values[i], levelDrr.pixels[pixels[i]]);
   }
   // Deterministic: a second render is bit-identical.
   fct::FloatImage first, second;
-  ASSERT_TRUE(transgraph.render(scene.view, pose, 0, first).ok());
-  ASSERT_TRUE(transgraph.render(scene.view, pose, 0, second).ok());
+  ASSERT_TRUE(renderer.render(scene.view, pose, 0, first).ok());
+  ASSERT_TRUE(renderer.render(scene.view, pose, 0, second).ok());
   EXPECT_EQ(first.pixels, second.pixels);
 }
 
@@ -249,15 +260,23 @@ TEST(Transgraph, RejectsBadInputsWithClearErrors) {
   ASSERT_FALSE(r6.ok());
   EXPECT_NE(r6.error().find("source"), std::string::npos) << r6.error();
 
-  const Transgraph& transgraph = sceneTransgraph();
+  auto volume = std::make_shared<const fct::DrrVolume>(fct::DrrVolume::create(scene.ct).value());
+  auto r7 = TransgraphRenderer::fromTransgraph(volume, Transgraph{});
+  ASSERT_FALSE(r7.ok());
+  EXPECT_NE(r7.error().find("empty"), std::string::npos) << r7.error();
+  auto r8 = TransgraphRenderer::create(nullptr, scene.view, scene.T_expected, scene.parameters);
+  ASSERT_FALSE(r8.ok());
+  EXPECT_NE(r8.error().find("empty"), std::string::npos) << r8.error();
+
+  // Rendering through the DrrRenderer interface still checks its inputs.
+  const TransgraphRenderer& renderer = sceneRenderer();
   fct::FloatImage drr;
-  EXPECT_FALSE(transgraph.render(scene.view, scene.T_expected, -1, drr).ok());
-  EXPECT_FALSE(transgraph.render(Camera{}, scene.T_expected, 0, drr).ok());
+  EXPECT_FALSE(renderer.render(scene.view, scene.T_expected, -1, drr).ok());
+  EXPECT_FALSE(renderer.render(Camera{}, scene.T_expected, 0, drr).ok());
   std::vector<float> values{1.0f};
-  EXPECT_FALSE(transgraph.renderPixels(scene.view, scene.T_expected, 0, {80 * 60}, values).ok());
-  ASSERT_TRUE(transgraph.renderPixels(scene.view, scene.T_expected, 0, {}, values).ok());
+  EXPECT_FALSE(renderer.renderPixels(scene.view, scene.T_expected, 0, {80 * 60}, values).ok());
+  ASSERT_TRUE(renderer.renderPixels(scene.view, scene.T_expected, 0, {}, values).ok());
   EXPECT_TRUE(values.empty());
-  EXPECT_FALSE(Transgraph{}.render(scene.view, scene.T_expected, 0, drr).ok());
 }
 
 TEST(Transgraph, BuildReportsProgressAndHonoursCancel) {
