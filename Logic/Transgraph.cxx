@@ -22,6 +22,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kRotationSamples = 7;
 // Rays closer than this (as w over the direction length) to the planes are too oblique for the two-plane table.
 constexpr double kMinDirectionCosine = 0.1;
+// Default offset step over plane step (see Transgraph.h).
+constexpr double kDefaultOffsetFactor = 3.0;
 
 Eigen::Matrix3d rotationZYX_deg(const Eigen::Vector3d& angles_deg) {
   const Eigen::Vector3d a = angles_deg * (kPi / 180.0);
@@ -86,7 +88,7 @@ Result<TransgraphLayout> Transgraph::plan(const Volume& ct, const Camera& view, 
     return fail(fmt::format("Transgraph plane spacing must be a positive number of mm, got {}", parameters.spacing_mm));
   }
   if (!std::isfinite(parameters.offsetSpacing_mm) || parameters.offsetSpacing_mm < 0.0) {
-    return fail(fmt::format("Transgraph offset spacing must be >= 0 mm (0: twice the plane spacing), got {}",
+    return fail(fmt::format("Transgraph offset spacing must be >= 0 mm (0: 3x the plane spacing), got {}",
                             parameters.offsetSpacing_mm));
   }
   if (!std::isfinite(parameters.range.rotation_deg) || parameters.range.rotation_deg < 0.0 ||
@@ -104,7 +106,7 @@ Result<TransgraphLayout> Transgraph::plan(const Volume& ct, const Camera& view, 
 
   TransgraphLayout layout;
   const double offsetSpacing_mm =
-      parameters.offsetSpacing_mm > 0.0 ? parameters.offsetSpacing_mm : 2.0 * parameters.spacing_mm;
+      parameters.offsetSpacing_mm > 0.0 ? parameters.offsetSpacing_mm : kDefaultOffsetFactor * parameters.spacing_mm;
   layout.step_mm = Eigen::Vector4d(parameters.spacing_mm, parameters.spacing_mm, offsetSpacing_mm, offsetSpacing_mm);
   layout.origin_ct_mm = ct.centre_lps_mm();
   layout.R_ct_from_plane = T_world_from_ct.linear().transpose() * view.T_world_from_camera().linear();

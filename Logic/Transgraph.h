@@ -10,7 +10,8 @@
 // is sampled on a regular grid. The offset keeps only the band of rays that a C-arm can produce (several times fewer
 // than the full (s1, t1, s2, t2) box), and the mid-plane point makes an offset step pivot the ray about the CT's
 // middle, which measured ~20 % less interpolation error than pivoting about the front plane. An offset step moves the
-// ray inside the CT at most half as far as a step of (s, t), so the offsets are sampled twice as coarsely by default.
+// ray inside the CT at most half as far as a step of (s, t), so the offsets are sampled more coarsely (3x by default,
+// chosen by measurement: at a fixed ray budget it gave a higher NCC with the exact DRR than 1x or 2x).
 // The table value of a ray is the integral from its front-plane point to its back-plane point, which equals the
 // integral along the whole line because the CT lies between the planes.
 
@@ -42,8 +43,10 @@ struct TransgraphRange {
 
 /// Build parameters of a Transgraph.
 struct TransgraphParameters {
-  double spacing_mm = 2.0;           ///< sampling step of the mid-plane point (s, t), mm
-  double offsetSpacing_mm = 0.0;     ///< sampling step of the offset (ds, dt), mm; 0 = 2 x spacing_mm
+  /// Sampling step of the mid-plane point (s, t), mm. 3 mm gives the paper's scale (15-30 M rays, 60-120 MB) for a
+  /// pelvis or head CT at ±15 deg, ±30 mm; 1.5 mm would need 16x more (rays grow with spacing^-4).
+  double spacing_mm = 3.0;
+  double offsetSpacing_mm = 0.0;     ///< sampling step of the offset (ds, dt), mm; 0 = 3 x spacing_mm
   TransgraphRange range;             ///< validity range around the expected pose
   double planeMargin_mm = 1.0;       ///< gap between the CT's bounding box and each plane
   std::size_t maxRays = 250'000'000; ///< refuse tables larger than this (4 bytes per ray)

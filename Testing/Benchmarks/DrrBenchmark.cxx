@@ -45,7 +45,7 @@ struct Options {
   int threads = 2;
   int repeats = 3;
   double transgraphRays = 15e6;
-  double offsetFactor = 2.0;  // Transgraph offset step / plane step
+  double offsetFactor = 3.0;  // Transgraph offset step / plane step (the library's default)
   int nccPoses = 20;
   bool plastimatch = true;
 };
