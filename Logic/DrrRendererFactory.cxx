@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "SiddonRayCaster.h"
+#include "TransgraphRenderer.h"
 #include "TrilinearRayCaster.h"
 
 namespace fct {
@@ -12,13 +13,15 @@ namespace fct {
 Result<DrrMethod> DrrRendererFactory::parseMethod(std::string_view name) {
   if (name == "raycast") return DrrMethod::RayCast;
   if (name == "siddon") return DrrMethod::Siddon;
-  return fail(fmt::format("unknown DRR method '{}'; use 'raycast' or 'siddon'", name));
+  if (name == "transgraph") return DrrMethod::Transgraph;
+  return fail(fmt::format("unknown DRR method '{}'; use 'siddon', 'raycast' or 'transgraph'", name));
 }
 
 std::string_view DrrRendererFactory::methodName(DrrMethod method) {
   switch (method) {
     case DrrMethod::RayCast: return "raycast";
     case DrrMethod::Siddon: return "siddon";
+    case DrrMethod::Transgraph: return "transgraph";
   }
   return "unknown";
 }
@@ -41,8 +44,25 @@ Result<std::unique_ptr<DrrRenderer>> DrrRendererFactory::create(std::shared_ptr<
     }
     case DrrMethod::Siddon:
       return std::unique_ptr<DrrRenderer>(std::make_unique<SiddonRayCaster>(std::move(volume)));
+    case DrrMethod::Transgraph:
+      return fail("the transgraph DRR method is built for one view and an expected pose; use createForView");
   }
   return fail("unknown DRR method");
+}
+
+Result<std::unique_ptr<DrrRenderer>> DrrRendererFactory::createForView(std::shared_ptr<const DrrVolume> volume,
+                                                                       const DrrRendererOptions& options,
+                                                                       const Camera& view,
+                                                                       const Eigen::Isometry3d& T_expected_world_from_ct,
+                                                                       const ProgressMonitor& monitor) {
+  if (options.method != DrrMethod::Transgraph) return create(std::move(volume), options);
+  auto renderer = TransgraphRenderer::create(std::move(volume), view, T_expected_world_from_ct, options.transgraph,
+                                             options.transgraphCacheFolder, monitor);
+  if (!renderer.ok()) return fail(renderer.error());
+  const std::vector<std::string> warnings = renderer.warnings();
+  Result<std::unique_ptr<DrrRenderer>> result(std::unique_ptr<DrrRenderer>(std::move(renderer).value()));
+  for (const auto& warning : warnings) result.addWarning(warning);
+  return result;
 }
 
 }  // namespace fct

@@ -29,6 +29,8 @@ struct DrrCommandOptions {
   std::string method = "siddon";
   std::string values = "attenuation";
   int level = 0;
+  std::string transgraphCache;  ///< empty = the default cache folder; "none" = no cache
+  double transgraphSpacing_mm = TransgraphParameters{}.spacing_mm;
 };
 
 /// A view name made safe for a file name: characters other than letters, digits, '-', '_' and '.' become '_'.
@@ -95,14 +97,23 @@ int runDrr(const DrrCommandOptions& options) {
   if (!drrVolume.ok()) return reportError(drrVolume.error());
   DrrRendererOptions rendererOptions;
   rendererOptions.method = method.value();
-  const auto renderer =
-      DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(drrVolume).value()), rendererOptions);
-  if (!renderer.ok()) return reportError(renderer.error());
+  rendererOptions.transgraph.spacing_mm = options.transgraphSpacing_mm;
+  if (options.transgraphCache == "none") {
+    rendererOptions.transgraphCacheFolder = std::nullopt;
+  } else {
+    rendererOptions.transgraphCacheFolder = fs::path(options.transgraphCache);
+  }
+  const auto prepared = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
 
   // Render every view before writing any file, so a view that cannot be rendered leaves nothing behind.
   std::vector<FloatImage> images(selected.size());
   std::vector<double> seconds(selected.size());
   for (std::size_t n = 0; n < selected.size(); ++n) {
+    // The transgraph method builds (or loads from its cache) one table per view around the requested pose.
+    const auto renderer =
+        DrrRendererFactory::createForView(prepared, rendererOptions, selected[n].camera, T_world_from_ct);
+    if (!renderer.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, renderer.error()));
+    for (const auto& warning : renderer.warnings()) fmt::print(stderr, "warning: {}\n", warning);
     const auto start = std::chrono::steady_clock::now();
     const Status rendered = renderer.value()->render(selected[n].camera, T_world_from_ct, options.level, images[n]);
     if (!rendered.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, rendered.error()));
@@ -133,12 +144,18 @@ void registerDrrCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--views", options->views, "View file (JSON) with the calibrated cameras")->required();
   command->add_option("--pose", options->pose, "Pose file with T_world_from_ct (default: identity)");
   command->add_option("--view", options->view, "Render only the view with this name");
-  command->add_option("--method", options->method, "raycast (trilinear sampling) or siddon (exact)")
+  command->add_option("--method", options->method, "siddon (exact voxel traversal), raycast (trilinear sampling) or transgraph (precomputed ray table per view, cached on disk; see README)")
       ->capture_default_str();
   command->add_option("--values", options->values,
                       "attenuation (integral of mu from HU, dimensionless) or raw (integral of voxel value, value*mm)")
       ->capture_default_str();
   command->add_option("--level", options->level, "Pyramid level: detector downsampled by 2^level per axis")
+      ->capture_default_str();
+  command->add_option("--transgraph-cache", options->transgraphCache,
+                      "Folder of the transgraph table cache (default: $XDG_CACHE_HOME/fluoroct/transgraph or "
+                      "~/.cache/fluoroct/transgraph); 'none' disables the cache");
+  command->add_option("--transgraph-spacing-mm", options->transgraphSpacing_mm,
+                      "Transgraph plane sampling step in mm (smaller: more accurate, rays grow as step^-4)")
       ->capture_default_str();
   command->add_option("--out", options->out, "Output prefix and format, e.g. out/drr.nrrd -> out/drr_<view>.nrrd")
       ->required();

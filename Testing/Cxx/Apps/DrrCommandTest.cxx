@@ -92,6 +92,26 @@ TEST(DrrCommand, RendersOneViewAtALevelWithRawValuesAndAPose) {
   EXPECT_EQ(*std::max_element(empty.pixels.begin(), empty.pixels.end()), 0.0f);
 }
 
+TEST(DrrCommand, TransgraphMethodMatchesSiddonAndCachesItsTable) {
+  const DrrFixture f;
+  const fs::path cache = f.dir / "cache";
+  const std::string transgraph = fmt::format(" --view AP --method transgraph --transgraph-spacing-mm 2 "
+                                             "--transgraph-cache '{}' --out '{}'",
+                                             cache.string(), (f.out / "tg.tif").string());
+  const auto first = fct::test::runCli(f.baseArguments() + transgraph);
+  ASSERT_EQ(first.exitCode, 0) << first.err;
+  ASSERT_TRUE(fs::is_directory(cache));
+  EXPECT_EQ(std::distance(fs::directory_iterator(cache), fs::directory_iterator{}), 1);
+  const auto second = fct::test::runCli(f.baseArguments() + transgraph);  // loads the cached table
+  ASSERT_EQ(second.exitCode, 0) << second.err;
+  const auto exact = fct::test::runCli(f.baseArguments() + fmt::format(" --view AP --out '{}'", (f.out / "ex.tif").string()));
+  ASSERT_EQ(exact.exitCode, 0) << exact.err;
+  const fct::XrayImage table = readTiff(f.out / "tg_AP.tif");
+  const fct::XrayImage siddon = readTiff(f.out / "ex_AP.tif");
+  ASSERT_EQ(table.pixels.size(), siddon.pixels.size());
+  EXPECT_NEAR(table.at(32, 24), siddon.at(32, 24), 0.01 * siddon.at(32, 24));
+}
+
 TEST(DrrCommand, WritesPfmNrrdAndWindowedPng) {
   const DrrFixture f;
   for (const char* ext : {"pfm", "nrrd", "png"}) {
@@ -118,7 +138,7 @@ TEST(DrrCommand, FailsWithOneErrorLineAndWritesNothingOnBadInput) {
       {fmt::format("drr --ct '{}' --views '{}' --out '{}'", f.ct.string(), (f.dir / "none.json").string(), out),
        "none.json"},
       {f.baseArguments() + fmt::format(" --view PA --out '{}'", out), "AP, Left lat"},
-      {f.baseArguments() + fmt::format(" --method raytrace --out '{}'", out), "'raycast' or 'siddon'"},
+      {f.baseArguments() + fmt::format(" --method raytrace --out '{}'", out), "'raycast' or 'transgraph'"},
       {f.baseArguments() + fmt::format(" --values hu --out '{}'", out), "'attenuation' or 'raw'"},
       {f.baseArguments() + fmt::format(" --out '{}'", (f.out / "bad.jpg").string()), ".nrrd, .pfm, .tif or .png"},
       {f.baseArguments() + fmt::format(" --out '{}'", (f.out / "no" / "d.tif").string()), "does not exist"},

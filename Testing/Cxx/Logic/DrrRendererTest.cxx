@@ -188,14 +188,14 @@ INSTANTIATE_TEST_SUITE_P(Methods, DrrRendererBehaviour, ::testing::Values(DrrMet
                          methodLabel);
 
 TEST(DrrRendererFactory, ParsesMethodNamesAndRejectsUnknownOnes) {
-  for (const DrrMethod method : {DrrMethod::RayCast, DrrMethod::Siddon}) {
+  for (const DrrMethod method : {DrrMethod::RayCast, DrrMethod::Siddon, DrrMethod::Transgraph}) {
     const auto parsed = fct::DrrRendererFactory::parseMethod(fct::DrrRendererFactory::methodName(method));
     ASSERT_TRUE(parsed.ok());
     EXPECT_EQ(parsed.value(), method);
   }
   const auto unknown = fct::DrrRendererFactory::parseMethod("raytrace");
   ASSERT_FALSE(unknown.ok());
-  EXPECT_NE(unknown.error().find("'raycast' or 'siddon'"), std::string::npos) << unknown.error();
+  EXPECT_NE(unknown.error().find("'raycast' or 'transgraph'"), std::string::npos) << unknown.error();
 }
 
 TEST(DrrRendererFactory, BuildsTheNamedMethodAndRejectsBadSetups) {

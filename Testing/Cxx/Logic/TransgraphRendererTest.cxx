@@ -1,10 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "Camera.h"
 #include "DrrTestPhantoms.h"
+#include "DrrRendererFactory.h"
 #include "DrrVolume.h"
 #include "RigidPose.h"
 #include "TestSupport.h"
@@ -142,3 +144,33 @@ TEST(TransgraphRenderer, SecondCreateLoadsCachedTableAndRendersTheSame) {
 }
 
 }  // namespace
+
+TEST(TransgraphRenderer, FactoryBuildsItPerViewAndRefusesItWithoutAView) {
+  const BallScene scene;
+  fct::DrrRendererOptions options;
+  options.method = fct::DrrMethod::Transgraph;
+  options.transgraph = scene.parameters;
+  options.transgraphCacheFolder = std::nullopt;
+  const auto withoutView = fct::DrrRendererFactory::create(scene.volume, options);
+  ASSERT_FALSE(withoutView.ok());
+  EXPECT_NE(withoutView.error().find("createForView"), std::string::npos) << withoutView.error();
+
+  const auto renderer = fct::DrrRendererFactory::createForView(scene.volume, options, scene.view, scene.T_expected);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  EXPECT_EQ(renderer.value()->methodName(), "transgraph");
+  // Inside the range the table agrees with the exact Siddon render of the same pose (block means within 1 %).
+  options.method = fct::DrrMethod::Siddon;
+  const auto siddon = fct::DrrRendererFactory::createForView(scene.volume, options, scene.view, scene.T_expected);
+  ASSERT_TRUE(siddon.ok()) << siddon.error();
+  const Eigen::Isometry3d pose = scene.poseWithin({2.0, -1.0, 1.5}, {3.0, -4.0, 2.0});
+  const auto table = renderer.value()->render(scene.view, pose);
+  const auto exact = siddon.value()->render(scene.view, pose);
+  ASSERT_TRUE(table.ok() && exact.ok());
+  double sumTable = 0.0, sumExact = 0.0;
+  for (std::size_t n = 0; n < exact.value().pixels.size(); ++n) {
+    sumTable += table.value().pixels[n];
+    sumExact += exact.value().pixels[n];
+  }
+  ASSERT_GT(sumExact, 0.0);
+  EXPECT_NEAR(sumTable / sumExact, 1.0, 0.01);
+}
