@@ -16,13 +16,8 @@ echo "== 1. the built-in phantom CT"
 echo "== 2. three standard C-arm views (AP, lateral, oblique) around the CT"
 "$BIN/fluoroct" views --ct phantom.nrrd --out views.json --count 3
 
-echo "== 3. simulated X-rays at a known bone pose (5 deg, -3 deg, 4 deg; 6, -4, 5 mm), with quantum noise"
-cat > truth_pose.json <<'JSON'
-{"T_world_from_ct": [[0.99376, -0.07317, 0.08436, 6.0],
-                     [0.06975, 0.99679, 0.03927, -4.0],
-                     [-0.08696, -0.03324, 0.99566, 5.0],
-                     [0, 0, 0, 1]]}
-JSON
+echo "== 3. simulated X-rays at a known bone pose (turned 5, -3, 4 deg about the bone centre, moved 6, -4, 5 mm)"
+"$BIN/fluoroct" pose --ct phantom.nrrd --rotate-deg 5 -3 4 --translate-mm 6 -4 5 --out truth_pose.json
 "$BIN/fluoroct" simulate --ct phantom.nrrd --views views.json --pose truth_pose.json --out case --noise-photons 20000 --seed 1
 
 echo "== 4. DRRs at the truth pose, exact (Siddon) and from the Transgraph ray table"

@@ -22,6 +22,8 @@ int reportError(const std::string& message);
 
 /// `fluoroct info`: describes a CT or an X-ray (text or --json).
 void registerInfoCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct pose`: writes a pose moved by a given or random offset about the bone centre.
+void registerPoseCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct phantom`: writes the built-in procedural CT phantom to a NRRD or MetaImage file.
 void registerPhantomCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct drr`: renders DRRs of a CT for the views of a view file.

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   CommandAction action;
   registerInfoCommand(app, action);
   registerPhantomCommand(app, action);
+  registerPoseCommand(app, action);
   registerDrrCommand(app, action);
   registerViewsCommand(app, action);
   registerSimulateCommand(app, action);
