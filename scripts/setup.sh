@@ -34,6 +34,8 @@ fct_install_packages() {
 
 fct_build() {
   local jobs="${FCT_JOBS:-$(nproc)}"
+  # Relative paths in ccache's keys, so that clones in other folders (CI) reuse the cache.
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$FCT_ROOT}"
   if [[ ! -f "$FCT_BUILD/build.ninja" ]]; then
     cmake -S "$FCT_ROOT" -B "$FCT_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release
   fi
