@@ -1,7 +1,9 @@
 #pragma once
 // SiddonRayCaster: exact DRRs by voxel traversal (Siddon 1985 path lengths, traversed incrementally as in
 // Jacobs et al. 1998 / Amanatides & Woo 1987). Each voxel is the box of one spacing around its centre; a ray's
-// integral is the sum over the voxels it crosses of (path length in the voxel) x (voxel value).
+// integral is the sum over the voxels it crosses of (path length in the voxel) x (voxel value). Near-axis rays (AP,
+// lateral) cross their dominant axis in runs: every voxel of a run but the first has the same path length, so a run
+// is a strided sum of voxel values (about half the instructions per DRR of single-boundary stepping on the head CT).
 
 #include <Eigen/Core>
 #include <memory>
