@@ -22,6 +22,8 @@ int reportError(const std::string& message);
 
 /// `fluoroct phantom`: writes the built-in procedural CT phantom to a NRRD or MetaImage file.
 void registerPhantomCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct register`: registers a CT to the X-ray views of a view file and writes the result JSON.
+void registerRegisterCommand(CLI::App& app, CommandAction& action);
 
 
 }  // namespace fct::cli

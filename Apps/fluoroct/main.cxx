@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "fluoroct 0.1.0");
   CommandAction action;
   registerPhantomCommand(app, action);
+  registerRegisterCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
