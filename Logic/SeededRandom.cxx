@@ -28,4 +28,31 @@ double SeededRandom::normal() {
   return radius * std::cos(angle);
 }
 
+std::int64_t SeededRandom::poisson(double mean) {
+  if (!(mean > 0.0)) return 0;
+  if (mean < 10.0) {
+    const double limit = std::exp(-mean);
+    std::int64_t count = 0;
+    for (double product = uniform01(); product > limit; product *= uniform01()) ++count;
+    return count;
+  }
+  // W. Hörmann, "The transformed rejection method for generating Poisson random variables", 1993 (PTRS).
+  const double sqrtMean = std::sqrt(mean), logMean = std::log(mean);
+  const double b = 0.931 + 2.53 * sqrtMean;
+  const double a = -0.059 + 0.02483 * b;
+  const double invAlpha = 1.1239 + 1.1328 / (b - 3.4);
+  const double vr = 0.9277 - 3.6224 / (b - 2.0);
+  for (;;) {
+    const double u = uniform01() - 0.5;
+    const double v = uniform01();
+    const double us = 0.5 - std::abs(u);
+    const double k = std::floor((2.0 * a / us + b) * u + mean + 0.43);
+    if (us >= 0.07 && v <= vr) return static_cast<std::int64_t>(k);
+    if (k < 0.0 || (us < 0.013 && v > us)) continue;
+    if (std::log(v) + std::log(invAlpha) - std::log(a / (us * us) + b) <= -mean + k * logMean - std::lgamma(k + 1.0)) {
+      return static_cast<std::int64_t>(k);
+    }
+  }
+}
+
 }  // namespace fct

@@ -22,6 +22,9 @@ class SeededRandom {
   int index(int count);
   /// Standard normal (Box–Muller).
   double normal();
+  /// Poisson-distributed count with the given mean (>= 0): multiplication method below a mean of 10, Hörmann's
+  /// transformed rejection (PTRS) above; exact in distribution. A mean <= 0 or NaN gives 0.
+  std::int64_t poisson(double mean);
 
  private:
   std::mt19937 m_engine;

@@ -22,6 +22,10 @@ int reportError(const std::string& message);
 
 /// `fluoroct phantom`: writes the built-in procedural CT phantom to a NRRD or MetaImage file.
 void registerPhantomCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct views`: writes a view file of standard C-arm views around a CT's centre.
+void registerViewsCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct simulate`: writes simulated X-ray images of a CT at a pose, with a view file and the true pose.
+void registerSimulateCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct register`: registers a CT to the X-ray views of a view file and writes the result JSON.
 void registerRegisterCommand(CLI::App& app, CommandAction& action);
 

@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "fluoroct 0.1.0");
   CommandAction action;
   registerPhantomCommand(app, action);
+  registerViewsCommand(app, action);
+  registerSimulateCommand(app, action);
   registerRegisterCommand(app, action);
   try {
     app.parse(argc, argv);
