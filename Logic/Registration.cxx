@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include "CmaEsOptimizer.h"
 #include "GeneticSearchOptimizer.h"
@@ -65,6 +66,15 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
   result.drrMethod = std::string(registrationCase.renderer().methodName());
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) result.viewNames.push_back(registrationCase.viewName(v));
 
+  // Every stage's pixel sets and metrics are built before the first search, so a stage that cannot run fails the
+  // registration at once instead of after the earlier stages' work.
+  std::vector<RegistrationObjective> objectives;
+  for (const RegistrationStage& stage : schedule.stages) {
+    auto created = RegistrationObjective::create(registrationCase, stage);
+    if (!created) return fail(created.error());
+    objectives.push_back(std::move(created).value());
+  }
+
   const ProgressMonitor monitor(ProgressMonitor::Callback{}, cancel);
   PoseVector current = initialParams.value().asVector();
   const int stageCount = static_cast<int>(schedule.stages.size());
@@ -76,9 +86,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       break;
     }
     const auto stageStart = Clock::now();
-    auto created = RegistrationObjective::create(registrationCase, stage);
-    if (!created) return fail(created.error());
-    RegistrationObjective& objective = created.value();
+    RegistrationObjective& objective = objectives[static_cast<std::size_t>(s)];
     auto startValue = objective.similarity(registrationCase.poseTransform(current));
     if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "CliSupport.h"
-#include "DicomSeriesReader.h"
+#include "CtVolumeReader.h"
 #include "JsonDocument.h"
 #include "JsonReader.h"
 #include "LandmarkFile.h"
@@ -22,7 +22,6 @@
 #include "PoseFile.h"
 #include "Registration.h"
 #include "ViewFile.h"
-#include "VolumeFileIO.h"
 #include "XrayDicomReader.h"
 #include "XrayImageFileReader.h"
 
@@ -43,17 +42,12 @@ struct Options {
   std::string out;
   std::string overlays;
   bool progress = false;
+  bool noFieldOfView = false;
   RegistrationAblation ablation;
 };
 
 std::atomic<bool> g_cancel{false};
 extern "C" void onInterrupt(int) { g_cancel.store(true); }
-
-Result<Volume> readCt(const fs::path& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) return DicomSeriesReader::read(path);
-  return VolumeFileIO::read(path);
-}
 
 Result<XrayImage> readImage(const ViewSpec& view) {
   if (view.imagePath.empty()) {
@@ -160,6 +154,7 @@ nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o,
         {"seed", o.seed},
         {"method", r.drrMethod},
         {"ablation", o.ablation.activeNames()},
+        {"field_of_view_detection", !o.noFieldOfView},
         {"schedule", r.schedule.toJson()}}}};
 }
 
@@ -198,8 +193,9 @@ int runRegister(const Options& o) {
   if (!viewSpecs) return reportError(viewSpecs.error());
   auto initial = initialPose(o, viewSpecs.value());
   if (!initial) return reportError(initial.error());
-  auto ct = readCt(o.ct);
+  auto ct = CtVolumeReader::read(o.ct);
   if (!ct) return reportError(ct.error());
+  for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
 
   std::vector<RegistrationView> views;
   for (const ViewSpec& spec : viewSpecs.value()) {
@@ -213,6 +209,7 @@ int runRegister(const Options& o) {
   }
   RegistrationCaseOptions caseOptions;
   caseOptions.drr.method = method.value();
+  caseOptions.preparation.detectFieldOfView = !o.noFieldOfView;
   auto registrationCase = RegistrationCase::create(ct.value(), views, caseOptions);
   if (!registrationCase) return reportError(registrationCase.error());
   for (const std::string& warning : registrationCase.warnings()) fmt::print(stderr, "warning: {}\n", warning);
@@ -271,6 +268,8 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
   command->add_option("--overlays", options->overlays, "Folder for one PNG per view with the bone contours");
   command->add_flag("--progress", options->progress, "Show a live progress bar on stderr");
+  command->add_flag("--no-fov", options->noFieldOfView,
+                    "Skip the field-of-view (collimator) detection, e.g. for simulated X-rays without a collimator");
   command->add_flag("--no-rois", options->ablation.noDynamicRois, "Ablation: every valid pixel instead of dynamic ROIs");
   command->add_flag("--no-pyramid", options->ablation.noPyramid, "Ablation: full resolution in every stage");
   command->add_flag("--ncc-only", options->ablation.nccOnly, "Ablation: NCC in every stage (no VLNC)");

@@ -4,7 +4,8 @@
 // no global search). Known-truth cases are simulated in-process (RegistrationTestCase.h); every run starts at 10 mm
 // mean bone-surface distance from the truth.
 //
-// Usage: fluoroct_registration_benchmark [--no-baseline] [STARTS] [phantom|pelvis|all] [PRESET ...]
+// Usage: fluoroct_registration_benchmark [--no-baseline] [--detector PIXELS PIXEL_MM] [STARTS] [phantom|pelvis|all]
+//                                        [PRESET ...]
 //   defaults: 3 starts, all cases, presets "fast" and "paper" (a PRESET may be a preset JSON file)
 #include <fmt/core.h>
 #include <fmt/ranges.h>
@@ -50,15 +51,18 @@ fct::RegistrationSchedule baselineSchedule() {
 }
 
 int runCase(const std::string& caseName, fct::Volume ct, int starts, const std::vector<std::string>& presets,
-            bool withBaseline) {
-  auto simulated = fct::test::simulateCase(std::move(ct));
+            bool withBaseline, const fct::test::KnownTruthOptions& detector) {
+  auto simulated = fct::test::simulateCase(std::move(ct), detector);
   if (!simulated) {
     fmt::print(stderr, "{}: {}\n", caseName, simulated.error());
     return 1;
   }
   const auto& sim = simulated.value();
+  // The simulated X-rays have no collimator: no field-of-view detection (it would take the pelvis's darkest band at
+  // the border of the lateral view for background).
   fct::RegistrationCaseOptions siddon;
-  fct::RegistrationCaseOptions raycast;
+  siddon.preparation.detectFieldOfView = false;
+  fct::RegistrationCaseOptions raycast = siddon;
   raycast.drr.method = fct::DrrMethod::RayCast;
   auto fastCase = fct::RegistrationCase::create(sim.ct, sim.views, siddon);
   auto baseCase = fct::RegistrationCase::create(sim.ct, sim.views, raycast);
@@ -136,6 +140,13 @@ int main(int argc, char** argv) {
     --argc;
     ++argv;
   }
+  fct::test::KnownTruthOptions detector;
+  if (argc > 3 && std::string(argv[1]) == "--detector") {
+    detector.cols = detector.rows = std::atoi(argv[2]);
+    detector.pixelSpacing_mm = std::atof(argv[3]);
+    argc -= 3;
+    argv += 3;
+  }
   const int starts = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
   const std::string which = argc > 2 ? argv[2] : "all";
   std::vector<std::string> presets(argv + std::min(argc, 3), argv + argc);
@@ -145,14 +156,14 @@ int main(int argc, char** argv) {
     fct::PhantomOptions phantom;
     phantom.dims = Eigen::Vector3i(80, 80, 60);
     phantom.spacing_mm = 2.0;
-    status |= runCase("phantom", fct::PhantomBuilder::build(phantom).value(), starts, presets, withBaseline);
+    status |= runCase("phantom", fct::PhantomBuilder::build(phantom).value(), starts, presets, withBaseline, detector);
   }
   if (which == "all" || which == "pelvis") {
     const char* env = std::getenv("FLUOROCT_DATA_DIR");
     const std::filesystem::path data = env ? env : FCT_DEFAULT_DATA_DIR;
     auto pelvis = fct::VolumeFileIO::read(data / "ct/pelvis_totalseg.nii.gz");
     if (pelvis) {
-      status |= runCase("pelvis", std::move(pelvis).value(), starts, presets, withBaseline);
+      status |= runCase("pelvis", std::move(pelvis).value(), starts, presets, withBaseline, detector);
     } else {
       fmt::print("pelvis skipped: {}\n", pelvis.error());
     }

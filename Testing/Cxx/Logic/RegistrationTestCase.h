@@ -1,67 +1,58 @@
 #pragma once
-// Known-truth registration cases for the registration tests and benchmark: a CT, three C-arm views (AP, lateral,
-// oblique with a cranial tilt) around the bone centre, X-rays simulated in-process by rendering DRRs at a truth pose
-// (Siddon), with multiplicative Gaussian noise, converted to intensities I = I0 exp(-p); and start poses at a given
-// mean bone-surface distance from the truth (random direction in scaled parameter space, fixed seed).
+// Known-truth registration cases for the registration tests and benchmark: a CT, the three standard C-arm views
+// (StandardViews: AP, lateral, oblique45 tilted) around the bone centre, X-rays simulated in-process by rendering
+// DRRs at a truth pose (Siddon) turned into noisy detector images (DrrXraySimulator::intensityFromDrr, Poisson noise
+// with the exposure raised per view so that its darkest pixel still gets a few photons, as exposure control does);
+// and start poses at a given mean bone-surface distance from the truth (random direction in scaled parameter space,
+// fixed seed).
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "BoneSurface.h"
-#include "Camera.h"
 #include "DrrRendererFactory.h"
+#include "DrrXraySimulator.h"
 #include "PoseOptimizer.h"
 #include "RegistrationCase.h"
 #include "Result.h"
 #include "RigidPose.h"
 #include "SeededRandom.h"
+#include "StandardViews.h"
 #include "Volume.h"
 
 namespace fct::test {
 
 /// Detector and noise of a simulated case.
-struct SimulatedCaseOptions {
-  int cols = 256;
-  int rows = 256;
-  double pixelSpacing_mm = 1.2;
-  double sourceToPatient_mm = 700.0;
+struct KnownTruthOptions {
+  int cols = 192;
+  int rows = 192;
+  double pixelSpacing_mm = 1.6;
+  double sourceToIsocentre_mm = 700.0;
   double sourceToDetector_mm = 1000.0;
-  double noise = 0.01;               ///< standard deviation of the multiplicative intensity noise
+  double noisePhotons = 2000.0;       ///< photons per unattenuated pixel (Poisson noise), at least:
+  double darkestPhotons = 20.0;       ///< photons at the view's darkest pixel (like automatic exposure control)
   double referenceIntensity = 4000;  ///< I0 of the simulated detector
   std::uint32_t seed = 11;
 };
 
-/// A CT with its bone surface, views with simulated X-rays, and the truth pose.
-struct SimulatedCase {
+/// A CT, views with simulated X-rays, and the truth pose.
+struct KnownTruthCase {
   Volume ct;
   std::vector<RegistrationView> views;
   Eigen::Isometry3d T_truth = Eigen::Isometry3d::Identity();
 };
 
-/// R_world_from_camera of a view looking along +y (posterior, AP) turned by `primary_deg` about the head-foot axis
-/// and tilted by `cranial_deg` about the left-right axis; image rows point to the feet.
-inline Eigen::Matrix3d viewRotation(double primary_deg, double cranial_deg) {
-  Eigen::Matrix3d R_ap;
-  R_ap.col(0) = Eigen::Vector3d(1, 0, 0);
-  R_ap.col(1) = Eigen::Vector3d(0, 0, -1);
-  R_ap.col(2) = Eigen::Vector3d(0, 1, 0);
-  const double d = M_PI / 180.0;
-  return (Eigen::AngleAxisd(cranial_deg * d, Eigen::Vector3d::UnitX()) *
-          Eigen::AngleAxisd(primary_deg * d, Eigen::Vector3d::UnitZ()))
-             .toRotationMatrix() *
-         R_ap;
-}
-
 /// Builds the case: the truth pose turns the bone by a few degrees about its centroid and puts the centroid near the
 /// world origin (the isocentre of the three views). Fails when the CT has no bone or rendering fails.
-inline Result<SimulatedCase> simulateCase(Volume ct, const SimulatedCaseOptions& o = {}) {
+inline Result<KnownTruthCase> simulateCase(Volume ct, const KnownTruthOptions& o = {}) {
   auto bone = BoneSurface::extract(ct);
   if (!bone) return fail(bone.error());
-  SimulatedCase c;
+  KnownTruthCase c;
   const Eigen::Vector3d centre = bone.value().centroid_ct_mm();
   PoseParameters truth;
   truth.rotation_deg = Eigen::Vector3d(4.0, -3.0, 6.0);
@@ -72,29 +63,34 @@ inline Result<SimulatedCase> simulateCase(Volume ct, const SimulatedCaseOptions&
   if (!drrVolume) return fail(drrVolume.error());
   auto renderer = DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(drrVolume).value()));
   if (!renderer) return fail(renderer.error());
-  const std::vector<std::pair<std::string, Eigen::Matrix3d>> views{
-      {"AP", viewRotation(0.0, 0.0)}, {"LAT", viewRotation(90.0, 0.0)}, {"OBL", viewRotation(45.0, 20.0)}};
-  SeededRandom random(o.seed);
-  for (const auto& [name, R] : views) {
-    const Camera camera = Camera::lookingAt(Eigen::Vector3d::Zero(), R, o.sourceToPatient_mm, o.sourceToDetector_mm,
-                                            o.cols, o.rows, o.pixelSpacing_mm);
-    auto drr = renderer.value()->render(camera, c.T_truth, 0);
+  StandardViewOptions viewOptions;
+  viewOptions.count = 3;
+  viewOptions.cols = o.cols;
+  viewOptions.rows = o.rows;
+  viewOptions.pixelSpacing_mm = o.pixelSpacing_mm;
+  viewOptions.sourceToDetector_mm = o.sourceToDetector_mm;
+  viewOptions.sourceToIsocentre_mm = o.sourceToIsocentre_mm;
+  auto views = StandardViews::build(Eigen::Vector3d::Zero(), viewOptions);
+  if (!views) return fail(views.error());
+  for (std::size_t v = 0; v < views.value().size(); ++v) {
+    const ViewSpec& spec = views.value()[v];
+    auto drr = renderer.value()->render(spec.camera, c.T_truth, 0);
     if (!drr) return fail(drr.error());
+    const float maxLineIntegral = *std::max_element(drr.value().pixels.begin(), drr.value().pixels.end());
+    const double photons = std::max(o.noisePhotons, o.darkestPhotons * std::exp(static_cast<double>(maxLineIntegral)));
+    auto intensity = DrrXraySimulator::intensityFromDrr(drr.value(), o.referenceIntensity, photons,
+                                                        o.seed + static_cast<std::uint32_t>(v));
+    if (!intensity) return fail(intensity.error());
     XrayImage xray;
     xray.cols = o.cols;
     xray.rows = o.rows;
     xray.modality = "simulated";
-    xray.pixels.resize(drr.value().pixels.size());
-    for (std::size_t i = 0; i < xray.pixels.size(); ++i) {
-      const double intensity = o.referenceIntensity * std::exp(-static_cast<double>(drr.value().pixels[i]));
-      xray.pixels[i] = static_cast<float>(std::max(0.0, intensity * (1.0 + o.noise * random.normal())));
-    }
-    c.views.push_back(RegistrationView{name, std::move(xray), camera, {}});
+    xray.pixels = std::move(intensity.value().pixels);
+    c.views.push_back(RegistrationView{spec.name, std::move(xray), spec.camera, {}});
   }
   c.ct = std::move(ct);
   return c;
 }
-
 /// A start pose whose mean bone-surface distance from `T_truth` is `distance_mm`: the truth's parameters plus a
 /// random direction (uniform on the sphere in scaled units) scaled by bisection. Deterministic for a seed.
 inline Eigen::Isometry3d startPose(const RegistrationCase& registrationCase, const Eigen::Isometry3d& T_truth,
