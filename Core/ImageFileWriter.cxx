@@ -11,6 +11,7 @@
 #include <functional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace fct {
 
@@ -109,6 +110,17 @@ Status ImageFileWriter::writePng16(const FloatImage& image, const std::filesyste
     }
   }
   return writeAtomically(path, [&](const std::filesystem::path& temp) { return imwriteStatus(temp, path, png); });
+}
+
+Status ImageFileWriter::writePngRgb(const RgbImage& image, const std::filesystem::path& path) {
+  if (image.cols <= 0 || image.rows <= 0 || image.pixels.size() != 3 * static_cast<std::size_t>(image.cols) * image.rows) {
+    return fail(fmt::format("cannot write '{}': colour image is empty or inconsistent ({} x {} with {} bytes)",
+                            path.filename().string(), image.cols, image.rows, image.pixels.size()));
+  }
+  cv::Mat bgr;
+  cv::cvtColor(cv::Mat(image.rows, image.cols, CV_8UC3, const_cast<std::uint8_t*>(image.pixels.data())), bgr,
+               cv::COLOR_RGB2BGR);
+  return writeAtomically(path, [&](const std::filesystem::path& temp) { return imwriteStatus(temp, path, bgr); });
 }
 
 Status ImageFileWriter::writeNrrd2d(const FloatImage& image, const std::filesystem::path& path,

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "FloatImage.h"
+#include "RgbImage.h"
 #include "Result.h"
 
 namespace fct {
@@ -24,6 +25,9 @@ class ImageFileWriter {
   /// Writes a 16-bit grey PNG mapping windowMin..windowMax linearly to 0..65535 (clamped; NaN -> 0).
   /// Fails unless windowMin < windowMax are finite, on an empty image or an unwritable path.
   static Status writePng16(const FloatImage& image, const std::filesystem::path& path, float windowMin, float windowMax);
+
+  /// Writes an 8-bit RGB PNG (e.g. an overlay). Fails on an empty or inconsistent image or an unwritable path.
+  static Status writePngRgb(const RgbImage& image, const std::filesystem::path& path);
 
   /// Writes a 2D float32 NRRD (raw, little endian, columns fastest) with `spacings` = pixelSpacing_mm (du, dv).
   /// Fails on an empty image, non-positive spacing or an unwritable path.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <system_error>
 
 #include "CliSupport.h"
 #include "CtVolumeReader.h"
@@ -53,9 +54,10 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       auto ct = CtVolumeReader::read(options->ct);
       if (!ct.ok()) return reportError(ct.error());
       for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+      std::error_code ec;
+      const std::filesystem::path ctPath = std::filesystem::absolute(options->ct, ec);
       auto simulated = DrrXraySimulator::writeCase(ct.value(), views.value(), pose.value(), options->simulation,
-                                                   options->out,
-                                                   std::filesystem::absolute(options->ct).string());
+                                                   options->out, ec ? options->ct : ctPath.string());
       if (!simulated.ok()) return reportError(simulated.error());
       for (std::size_t n = 0; n < simulated.value().views.size(); ++n) {
         const ViewSpec& view = simulated.value().views[n];

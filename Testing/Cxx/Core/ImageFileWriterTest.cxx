@@ -136,3 +136,26 @@ TEST(ImageFileWriter, RejectsBadInputsWithoutLeavingFiles) {
   EXPECT_EQ(slurp(dir / "keep.pfm"), before);
   expectOnlyFile(dir, "keep.pfm");
 }
+
+TEST(ImageFileWriter, RgbPngRoundTripsAndRejectsInconsistentImages) {
+  fct::RgbImage image;
+  image.cols = 5;
+  image.rows = 3;
+  for (int n = 0; n < 15; ++n) {
+    image.pixels.push_back(static_cast<std::uint8_t>(10 * n));
+    image.pixels.push_back(static_cast<std::uint8_t>(200 - n));
+    image.pixels.push_back(static_cast<std::uint8_t>(7));
+  }
+  const auto path = fct::test::scratchDir() / "rgb.png";
+  ASSERT_TRUE(fct::ImageFileWriter::writePngRgb(image, path).ok());
+  const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(bgr.type(), CV_8UC3);
+  const cv::Vec3b last = bgr.at<cv::Vec3b>(2, 4);
+  EXPECT_EQ(last[2], 140);  // red of pixel 14
+  EXPECT_EQ(last[1], 186);
+  EXPECT_EQ(last[0], 7);
+  fct::RgbImage broken = image;
+  broken.pixels.pop_back();
+  EXPECT_FALSE(fct::ImageFileWriter::writePngRgb(broken, fct::test::scratchDir() / "broken.png").ok());
+  EXPECT_FALSE(std::filesystem::exists(fct::test::scratchDir() / "broken.png"));
+}

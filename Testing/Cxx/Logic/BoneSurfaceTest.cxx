@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "BoneSurface.h"
 #include "PhantomBuilder.h"
+#include "TestSupport.h"
+#include "VolumeFileIO.h"
 
 namespace {
 
@@ -129,4 +132,21 @@ TEST(BoneSurface, RejectsEmptyVolumeAndBadArguments) {
   const fct::Volume ball = ballVolume(kBallCentre_lps_mm, kBallRadius_mm);
   EXPECT_FALSE(fct::BoneSurface::extract(ball, std::nan(""), 100).ok());
   EXPECT_FALSE(fct::BoneSurface::extract(ball, 250.0, 0).ok());
+}
+
+TEST(BoneSurface, FindsThePelvisCtsBone) {
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  auto ct = fct::VolumeFileIO::read(fct::test::dataDir() / "ct/pelvis_totalseg.nii.gz");
+  ASSERT_TRUE(ct.ok()) << ct.error();
+  const auto surface = fct::BoneSurface::extract(ct.value());
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  // At 3 mm voxels the bone has fewer boundary voxels than the default cap, so all are kept.
+  EXPECT_GT(surface.value().boundaryVoxelCount(), 5000u);
+  EXPECT_EQ(surface.value().points_ct_mm().size(),
+            std::min(surface.value().boundaryVoxelCount(), fct::BoneSurface::kDefaultMaxPoints));
+  // Pelvis, spine and hips span a few hundred mm; the centroid lies inside the CT's field of view.
+  EXPECT_GT(surface.value().radius_mm(), 50.0);
+  EXPECT_LT(surface.value().radius_mm(), 250.0);
+  const Eigen::Vector3d ijk = ct.value().ijkFromLps(surface.value().centroid_ct_mm());
+  EXPECT_TRUE((ijk.array() >= 0.0).all() && (ijk.array() < ct.value().dims().cast<double>().array()).all()) << ijk;
 }

@@ -1,0 +1,133 @@
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "PoseFile.h"
+#include "TestSupport.h"
+#include "ViewFile.h"
+#include "XrayImageFileReader.h"
+
+namespace {
+
+/// A fresh folder for this test's files (runCli() wipes scratchDir() on each call, so the files live beside it).
+std::filesystem::path workDir() {
+  const auto dir = fct::test::scratchDir().parent_path() /
+                   (std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_files");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+/// Writes a small phantom, a 3-view file with a small detector and a pose into `dir`.
+void makeInputs(const std::filesystem::path& dir) {
+  ASSERT_EQ(fct::test::runCli(fmt::format("phantom --out '{}' --dims 40 40 30 --spacing-mm 4", (dir / "ct.nrrd").string()))
+                .exitCode,
+            0);
+  const auto views = fct::test::runCli(fmt::format(
+      "views --ct '{}' --out '{}' --count 3 --detector 100x80 --pixel-mm 3", (dir / "ct.nrrd").string(),
+      (dir / "views.json").string()));
+  ASSERT_EQ(views.exitCode, 0) << views.err;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translate(Eigen::Vector3d(2.0, -1.0, 3.0));
+  ASSERT_TRUE(fct::PoseFile::write(pose, dir / "pose.json").ok());
+}
+
+}  // namespace
+
+TEST(ViewsCommand, WritesStandardViewsAroundTheCtCentre) {
+  const auto dir = workDir();
+  makeInputs(dir);
+  auto views = fct::ViewFile::read(dir / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  ASSERT_EQ(views.value().size(), 3u);
+  EXPECT_EQ(views.value()[0].name, "ap");
+  EXPECT_EQ(views.value()[1].name, "lateral");
+  EXPECT_EQ(views.value()[2].name, "oblique45");
+  EXPECT_TRUE(views.value()[1].imagePath.empty());
+  EXPECT_EQ(views.value()[0].camera.intrinsics().cols, 100);
+  EXPECT_EQ(views.value()[0].camera.intrinsics().rows, 80);
+  EXPECT_DOUBLE_EQ(views.value()[0].camera.intrinsics().pixelSpacing_mm.x(), 3.0);
+}
+
+TEST(ViewsCommand, ImagesOptionNamesOneImagePerView) {
+  const auto dir = workDir();
+  makeInputs(dir);
+  const auto run = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --count 2 --images '{}'",
+                                                 (dir / "ct.nrrd").string(), (dir / "named.json").string(),
+                                                 (dir / "xray").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  std::ifstream file(dir / "named.json");
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"path\": \"xray_ap.png\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"path\": \"xray_lateral.png\""), std::string::npos) << text;
+}
+
+TEST(SimulateCommand, WritesARegistrationCase) {
+  const auto dir = workDir();
+  makeInputs(dir);
+  const auto out = dir / "case";
+  const auto run = fct::test::runCli(fmt::format(
+      "simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --noise-photons 2000 --seed 4 --method raycast",
+      (dir / "ct.nrrd").string(), (dir / "views.json").string(), (dir / "pose.json").string(), out.string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  auto views = fct::ViewFile::read(out / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  ASSERT_EQ(views.value().size(), 3u);
+  for (const auto& view : views.value()) {
+    SCOPED_TRACE(view.name);
+    EXPECT_EQ(view.imagePath, out / (view.name + ".png"));
+    auto image = fct::XrayImageFileReader::read(view.imagePath);
+    ASSERT_TRUE(image.ok()) << image.error();
+    EXPECT_EQ(image.value().cols, 100);
+    EXPECT_EQ(image.value().rows, 80);
+    const auto [lo, hi] = std::minmax_element(image.value().pixels.begin(), image.value().pixels.end());
+    EXPECT_LT(*lo, 20000.0f);  // the body attenuates
+    EXPECT_GT(*hi, 55000.0f);  // air around it, about I0 = 60000 with noise
+  }
+  auto truth = fct::PoseFile::read(out / "truth_pose.json");
+  ASSERT_TRUE(truth.ok()) << truth.error();
+  EXPECT_NEAR(truth.value().translation().z(), 3.0, 1e-12);
+  std::ifstream parameters(out / "simulation.json");
+  const std::string text((std::istreambuf_iterator<char>(parameters)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"noise_photons\": 2000"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"method\": \"raycast\""), std::string::npos) << text;
+}
+
+TEST(SimulateCommand, FailsCleanlyOnBadInputs) {
+  const auto dir = workDir();
+  makeInputs(dir);
+  const auto out = dir / "case";
+  const std::string base = fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'", (dir / "ct.nrrd").string(),
+                                       (dir / "views.json").string(), (dir / "pose.json").string(), out.string());
+  for (const std::string& extra : {std::string(" --method magic"), std::string(" --noise-photons -5"),
+                                   std::string(" --i0 70000"), std::string(" --i0 0")}) {
+    SCOPED_TRACE(extra);
+    const auto run = fct::test::runCli(base + extra);
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.err.rfind("error: ", 0), 0u) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
+  const auto missingCt = fct::test::runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'",
+                                                       (dir / "nope.nrrd").string(), (dir / "views.json").string(),
+                                                       (dir / "pose.json").string(), out.string()));
+  EXPECT_EQ(missingCt.exitCode, 2);
+  EXPECT_NE(missingCt.err.find("nope.nrrd"), std::string::npos) << missingCt.err;
+  const auto missingPose = fct::test::runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'",
+                                                         (dir / "ct.nrrd").string(), (dir / "views.json").string(),
+                                                         (dir / "none.json").string(), out.string()));
+  EXPECT_EQ(missingPose.exitCode, 2);
+  EXPECT_FALSE(std::filesystem::exists(out)) << "failed runs must not create the case folder";
+
+  const auto badCount = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --count 7", (dir / "ct.nrrd").string(),
+                                                      (dir / "v7.json").string()));
+  EXPECT_EQ(badCount.exitCode, 2);
+  EXPECT_NE(badCount.err.find("1..5"), std::string::npos) << badCount.err;
+  const auto badDetector = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --detector 800by600",
+                                                         (dir / "ct.nrrd").string(), (dir / "vd.json").string()));
+  EXPECT_EQ(badDetector.exitCode, 2);
+  EXPECT_NE(badDetector.err.find("COLSxROWS"), std::string::npos) << badDetector.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "v7.json"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "vd.json"));
+}
