@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "CliSupport.h"
+#include "ContourOverlay.h"
 #include "CtVolumeReader.h"
 #include "JsonDocument.h"
 #include "JsonReader.h"
@@ -229,6 +230,18 @@ int runRegister(const Options& o) {
   if (!result) return reportError(result.error());
   const RegistrationResult& r = result.value();
 
+  if (!o.overlays.empty()) {
+    auto overlay = ContourOverlay::create(ct.value(), caseOptions.boneThreshold_hu);
+    if (!overlay) return reportError("overlays: " + overlay.error());
+    std::error_code ec;
+    fs::create_directories(o.overlays, ec);
+    if (ec) return reportError(fmt::format("cannot create the overlay folder '{}': {}", o.overlays, ec.message()));
+    for (const RegistrationView& view : views) {
+      const Status written = overlay.value().writeOverlayPng(view.xray, view.camera, r.T_initial, r.T_world_from_ct,
+                                                             fs::path(o.overlays) / (view.name + ".png"));
+      if (!written) return reportError(fmt::format("overlay of view '{}': {}", view.name, written.error()));
+    }
+  }
   if (!o.out.empty()) {
     const Status written = JsonDocument::write(resultJson(r, o, initial.value().second), o.out);
     if (!written) return reportError(written.error());
@@ -266,7 +279,9 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--method", options->method, "DRR method: siddon, raycast (or any method the build offers)")
       ->capture_default_str();
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
-  command->add_option("--overlays", options->overlays, "Folder for one PNG per view with the bone contours");
+  command->add_option("--overlays", options->overlays,
+                      "Folder for one PNG per view (<view>.png) with the bone outlines at the initial (red) and final "
+                      "(green) pose over the X-ray");
   command->add_flag("--progress", options->progress, "Show a live progress bar on stderr");
   command->add_flag("--no-fov", options->noFieldOfView,
                     "Skip the field-of-view (collimator) detection, e.g. for simulated X-rays without a collimator");

@@ -56,9 +56,9 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   const Eigen::Isometry3d truth = makeCase(dir);
   ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
   const auto run = fct::test::runCli(fmt::format(
-      "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --out '{}' --progress",
+      "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --out '{}' --progress --overlays '{}'",
       (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(),
-      (dir / "result.json").string()));
+      (dir / "result.json").string(), (dir / "overlays").string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("registered"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("stage 1/4"), std::string::npos) << "progress bar on stderr: " << run.err;
@@ -85,6 +85,9 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   EXPECT_EQ(json["options"]["schedule"]["stages"].size(), 4u);
   EXPECT_EQ(json["initial_pose"]["source"], "pose file");
   EXPECT_EQ(json["initial_pose"]["T_world_from_ct"].size(), 4u);
+  for (const char* view : {"ap", "lateral", "oblique45"}) {
+    EXPECT_GT(fs::file_size(dir / "overlays" / (std::string(view) + ".png")), 1000u) << view;
+  }
 }
 
 TEST(RegisterCommand, EstimatesTheInitialPoseFromLandmarks) {
