@@ -32,6 +32,8 @@ void registerDrrCommand(CLI::App& app, CommandAction& action);
 void registerViewsCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct simulate`: writes simulated X-ray images of a CT at a pose, with a view file and the true pose.
 void registerSimulateCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct register`: registers a CT to the X-ray views of a view file and writes the result JSON.
+void registerRegisterCommand(CLI::App& app, CommandAction& action);
 
 
 }  // namespace fct::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   registerDrrCommand(app, action);
   registerViewsCommand(app, action);
   registerSimulateCommand(app, action);
+  registerRegisterCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -32,6 +32,7 @@ std::filesystem::path scratchDir() {
 std::filesystem::path cliPath() { return FCT_CLI_PATH; }
 
 ProcessResult runCli(const std::string& arguments) {
+  // Not scratchDir(): that would empty the calling test's folder before every command.
   const auto dir = std::filesystem::temp_directory_path() / "fluoroct_tests" / "cli_capture";
   std::filesystem::create_directories(dir);
   const auto outPath = dir / fmt::format("out_{}.txt", ::getpid());

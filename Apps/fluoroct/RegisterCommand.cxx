@@ -1,0 +1,296 @@
+// fluoroct register: registers a CT to the X-ray views of a view file (Registration, a preset schedule) from an
+// initial pose given as a pose file or estimated from landmarks; writes RESULT.json.
+#include <fmt/core.h>
+#include <fmt/ranges.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "CliSupport.h"
+#include "ContourOverlay.h"
+#include "CtVolumeReader.h"
+#include "JsonDocument.h"
+#include "JsonReader.h"
+#include "LandmarkFile.h"
+#include "LandmarkPoseEstimator.h"
+#include "PoseFile.h"
+#include "Registration.h"
+#include "ViewFile.h"
+#include "XrayDicomReader.h"
+#include "XrayImageFileReader.h"
+
+namespace fct::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string ct;
+  std::string views;
+  std::string init;
+  std::string landmarks;
+  std::string preset = "paper";
+  std::uint32_t seed = 1;
+  std::string method = "siddon";
+  std::string out;
+  std::string overlays;
+  bool progress = false;
+  bool noFieldOfView = false;
+  RegistrationAblation ablation;
+};
+
+std::atomic<bool> g_cancel{false};
+extern "C" void onInterrupt(int) { g_cancel.store(true); }
+
+Result<XrayImage> readImage(const ViewSpec& view) {
+  if (view.imagePath.empty()) {
+    return fail(fmt::format("view '{}' has no image; registration needs an X-ray per view (key \"image\" of the view "
+                            "file)",
+                            view.name));
+  }
+  std::string extension = view.imagePath.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  auto image = (extension == ".png" || extension == ".tif" || extension == ".tiff")
+                   ? XrayImageFileReader::read(view.imagePath)
+                   : XrayDicomReader::read(view.imagePath, view.frame);
+  if (!image) return fail(fmt::format("view '{}': {}", view.name, image.error()));
+  return image;
+}
+
+/// The initial pose from --init or --landmarks, and a JSON description of where it came from.
+Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const Options& o,
+                                                                         const std::vector<ViewSpec>& views) {
+  if (!o.init.empty()) {
+    auto pose = PoseFile::read(o.init);
+    if (!pose) return fail(pose.error());
+    return std::make_pair(pose.value(), nlohmann::ordered_json{{"source", "pose file"}, {"path", o.init}});
+  }
+  auto document = JsonDocument::parse(o.landmarks);
+  if (!document) return fail(document.error());
+  JsonReader reader(document.value(), o.landmarks);
+  const std::string ctFile = reader.string("ct");
+  const std::string imageFile = reader.string("image");
+  std::string method = "reprojection";
+  if (reader.has("method")) method = reader.string("method");
+  if (reader.ok() && method != "reprojection" && method != "triangulation") {
+    reader.rejectKey("method", fmt::format("is '{}'; use 'reprojection' or 'triangulation'", method));
+  }
+  if (!reader.ok()) return fail(reader.error());
+  const fs::path folder = fs::path(o.landmarks).parent_path();
+  auto ctLandmarks = LandmarkFile::readCt(folder / ctFile);
+  if (!ctLandmarks) return fail(ctLandmarks.error());
+  auto imageLandmarks = LandmarkFile::readImage(folder / imageFile);
+  if (!imageLandmarks) return fail(imageLandmarks.error());
+  std::map<std::string, Camera> cameras;
+  for (const ViewSpec& view : views) cameras.emplace(view.name, view.camera);
+  for (const auto& [viewName, clicks] : imageLandmarks.value()) {
+    if (!cameras.count(viewName)) {
+      std::vector<std::string> names;
+      for (const ViewSpec& view : views) names.push_back(view.name);
+      return fail(fmt::format("{}: landmarks are clicked in view '{}', which the view file does not have (views: {}); "
+                              "the landmark and view files must name the same views",
+                              (folder / imageFile).string(), viewName, fmt::join(names, ", ")));
+    }
+  }
+  const Landmarks landmarks{ctLandmarks.value(), imageLandmarks.value()};
+  auto estimate = method == "triangulation" ? LandmarkPoseEstimator::fromTriangulation(landmarks, cameras)
+                                            : LandmarkPoseEstimator::fromReprojection(landmarks, cameras);
+  if (!estimate) return fail("initial pose from landmarks: " + estimate.error());
+  const LandmarkPoseEstimate& e = estimate.value();
+  nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
+  for (const LandmarkResidual& r : e.residuals) {
+    nlohmann::ordered_json perView = nlohmann::ordered_json::object();
+    for (const auto& [viewName, px] : r.reprojection_px) perView[viewName] = px;
+    nlohmann::ordered_json entry{{"name", r.name}, {"reprojection_px", perView}};
+    if (std::isfinite(r.distance_mm)) entry["distance_mm"] = r.distance_mm;
+    residuals.push_back(std::move(entry));
+  }
+  nlohmann::ordered_json source{{"source", "landmarks"},
+                                {"path", o.landmarks},
+                                {"method", e.method},
+                                {"rms_reprojection_px", e.rmsReprojection_px}};
+  if (std::isfinite(e.rms3d_mm)) source["rms_3d_mm"] = e.rms3d_mm;
+  source["residuals"] = std::move(residuals);
+  return std::make_pair(e.T_world_from_ct, std::move(source));
+}
+
+nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o, nlohmann::ordered_json initial) {
+  nlohmann::ordered_json stages = nlohmann::ordered_json::array();
+  for (const StageReport& s : r.stages) {
+    nlohmann::ordered_json kept = nlohmann::ordered_json::object();
+    for (std::size_t v = 0; v < s.keptFraction.size() && v < r.viewNames.size(); ++v) kept[r.viewNames[v]] = s.keptFraction[v];
+    stages.push_back({{"name", s.name},
+                      {"metric", s.metric},
+                      {"level", s.level},
+                      {"search", s.search},
+                      {"seconds", s.seconds},
+                      {"drrs", s.drrs},
+                      {"evaluations", s.evaluations},
+                      {"start_similarity", s.startSimilarity},
+                      {"similarity", s.similarity},
+                      {"kept_fraction", kept},
+                      {"cancelled", s.cancelled}});
+  }
+  initial["T_world_from_ct"] = JsonDocument::array(r.T_initial.matrix());
+  return nlohmann::ordered_json{
+      {"T_world_from_ct", JsonDocument::array(r.T_world_from_ct.matrix())},
+      {"cancelled", r.cancelled},
+      {"initial_pose", std::move(initial)},
+      {"stages", std::move(stages)},
+      {"total_seconds", r.totalSeconds},
+      {"total_drrs", r.totalDrrs},
+      {"rotation_centre_ct_mm", JsonDocument::array(r.rotationCentre_ct_mm)},
+      {"options",
+       {{"ct", o.ct},
+        {"views", o.views},
+        {"preset", o.preset},
+        {"seed", o.seed},
+        {"method", r.drrMethod},
+        {"ablation", o.ablation.activeNames()},
+        {"field_of_view_detection", !o.noFieldOfView},
+        {"schedule", r.schedule.toJson()}}}};
+}
+
+/// Draws a one-line progress bar on stderr, at most every 100 ms.
+class ProgressBar {
+ public:
+  void update(const RegistrationProgress& p) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - m_last < std::chrono::milliseconds(100)) return;
+    m_last = now;
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(p.fraction * kWidth + 0.5);
+    fmt::print(stderr, "\r[{}{}] {:3.0f}%  stage {}/{} {:<16} eval {:5}  DRRs {:6}  best {:.4f} ",
+               std::string(static_cast<std::size_t>(filled), '#'), std::string(kWidth - filled, '.'), 100.0 * p.fraction,
+               p.stageIndex + 1, p.stageCount, p.stage, p.iteration, p.drrs, p.bestSimilarity);
+    m_drawn = true;
+  }
+  void finish() {
+    if (m_drawn) fmt::print(stderr, "\n");
+  }
+
+ private:
+  std::chrono::steady_clock::time_point m_last{};
+  bool m_drawn = false;
+};
+
+int runRegister(const Options& o) {
+  if (o.init.empty() == o.landmarks.empty()) {
+    return reportError("give the initial pose with exactly one of --init POSE.json or --landmarks LM.json");
+  }
+  auto method = DrrRendererFactory::parseMethod(o.method);
+  if (!method) return reportError(method.error());
+  auto schedule = RegistrationSchedule::resolve(o.preset);
+  if (!schedule) return reportError(schedule.error());
+  auto viewSpecs = ViewFile::read(o.views);
+  if (!viewSpecs) return reportError(viewSpecs.error());
+  auto initial = initialPose(o, viewSpecs.value());
+  if (!initial) return reportError(initial.error());
+  auto ct = CtVolumeReader::read(o.ct);
+  if (!ct) return reportError(ct.error());
+  for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+
+  std::vector<RegistrationView> views;
+  for (const ViewSpec& spec : viewSpecs.value()) {
+    auto image = readImage(spec);
+    if (!image) return reportError(image.error());
+    RegistrationView view{spec.name, std::move(image).value(), spec.camera, {}};
+    for (const CalibrationSphere& sphere : spec.calibrationSpheres) {
+      view.spheres.push_back(PixelCircle{sphere.center_px, sphere.radius_px});
+    }
+    views.push_back(std::move(view));
+  }
+  RegistrationCaseOptions caseOptions;
+  caseOptions.drr.method = method.value();
+  caseOptions.preparation.detectFieldOfView = !o.noFieldOfView;
+  auto registrationCase = RegistrationCase::create(ct.value(), views, caseOptions);
+  if (!registrationCase) return reportError(registrationCase.error());
+  for (const std::string& warning : registrationCase.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+
+  RegistrationOptions options;
+  options.schedule = schedule.value();
+  options.ablation = o.ablation;
+  options.seed = o.seed;
+  ProgressBar bar;
+  RegistrationProgressCallback onProgress;
+  if (o.progress) onProgress = [&bar](const RegistrationProgress& p) { bar.update(p); };
+  g_cancel = false;
+  const auto previousHandler = std::signal(SIGINT, onInterrupt);
+  auto result = Registration::run(registrationCase.value(), initial.value().first, options, onProgress, &g_cancel);
+  std::signal(SIGINT, previousHandler);
+  bar.finish();
+  if (!result) return reportError(result.error());
+  const RegistrationResult& r = result.value();
+
+  if (!o.overlays.empty()) {
+    auto overlay = ContourOverlay::create(ct.value(), caseOptions.boneThreshold_hu);
+    if (!overlay) return reportError("overlays: " + overlay.error());
+    std::error_code ec;
+    fs::create_directories(o.overlays, ec);
+    if (ec) return reportError(fmt::format("cannot create the overlay folder '{}': {}", o.overlays, ec.message()));
+    for (const RegistrationView& view : views) {
+      const Status written = overlay.value().writeOverlayPng(view.xray, view.camera, r.T_initial, r.T_world_from_ct,
+                                                             fs::path(o.overlays) / (view.name + ".png"));
+      if (!written) return reportError(fmt::format("overlay of view '{}': {}", view.name, written.error()));
+    }
+  }
+  if (!o.out.empty()) {
+    const Status written = JsonDocument::write(resultJson(r, o, initial.value().second), o.out);
+    if (!written) return reportError(written.error());
+  }
+  for (const StageReport& s : r.stages) {
+    fmt::print("stage {:<16} {:>4} level {} {:<7} {:7.2f} s {:7} DRRs  similarity {:.4f} -> {:.4f}{}\n", s.name,
+               s.metric, s.level, s.search, s.seconds, s.drrs, s.startSimilarity, s.similarity,
+               s.cancelled ? " (cancelled)" : "");
+  }
+  fmt::print("{} in {:.2f} s, {} DRRs ({} method){}\n", r.cancelled ? "cancelled" : "registered", r.totalSeconds,
+             r.totalDrrs, r.drrMethod, o.out.empty() ? "" : fmt::format("; wrote {}", o.out));
+  return 0;
+}
+
+}  // namespace
+
+void registerRegisterCommand(CLI::App& app, CommandAction& action) {
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand(
+      "register", "Register a CT to the X-ray views of a view file (Knaan & Joskowicz 2003 pipeline) from an initial "
+                  "pose or landmarks; writes the pose, per-stage timings and similarities to RESULT.json");
+  command->add_option("--ct", options->ct, "CT volume (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd) or DICOM series folder")
+      ->required();
+  command->add_option("--views", options->views, "View file (JSON) with each view's image, detector and camera")
+      ->required();
+  auto* init = command->add_option("--init", options->init, "Initial pose file {\"T_world_from_ct\": 4x4}");
+  auto* landmarks = command->add_option(
+      "--landmarks", options->landmarks,
+      "Landmark pair file {\"ct\": \"points.mrk.json\", \"image\": \"clicks.json\", \"method\": "
+      "\"reprojection\"|\"triangulation\"} (paths relative to it)");
+  init->excludes(landmarks);
+  command->add_option("--preset", options->preset, "Schedule: 'paper', 'fast' or a preset JSON file")
+      ->capture_default_str();
+  command->add_option("--seed", options->seed, "Seed of the random searches")->capture_default_str();
+  command->add_option("--method", options->method, "DRR method: siddon, raycast (or any method the build offers)")
+      ->capture_default_str();
+  command->add_option("--out", options->out, "Result JSON file (written atomically)");
+  command->add_option("--overlays", options->overlays,
+                      "Folder for one PNG per view (<view>.png) with the bone outlines at the initial (red) and final "
+                      "(green) pose over the X-ray");
+  command->add_flag("--progress", options->progress, "Show a live progress bar on stderr");
+  command->add_flag("--no-fov", options->noFieldOfView,
+                    "Skip the field-of-view (collimator) detection, e.g. for simulated X-rays without a collimator");
+  command->add_flag("--no-rois", options->ablation.noDynamicRois, "Ablation: every valid pixel instead of dynamic ROIs");
+  command->add_flag("--no-pyramid", options->ablation.noPyramid, "Ablation: full resolution in every stage");
+  command->add_flag("--ncc-only", options->ablation.nccOnly, "Ablation: NCC in every stage (no VLNC)");
+  command->add_flag("--local-only", options->ablation.localOnly, "Ablation: local simplex instead of global search");
+  command->add_flag("--cmaes", options->ablation.cmaesForGenetic, "CMA-ES instead of the genetic search");
+  command->callback([&action, options] { action = [options] { return runRegister(*options); }; });
+}
+
+}  // namespace fct::cli

@@ -1,0 +1,130 @@
+#include "RegistrationCase.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "RigidPose.h"
+
+namespace fct {
+
+Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::vector<RegistrationView>& views,
+                                                  const RegistrationCaseOptions& options) {
+  if (views.empty()) return fail("registration needs at least one X-ray view; the view list is empty");
+  RegistrationCase result;
+
+  auto drrVolume = DrrVolume::create(ct);
+  if (!drrVolume) return fail("CT: " + drrVolume.error());
+  result.m_drrVolume = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
+  auto renderer = DrrRendererFactory::create(result.m_drrVolume, options.drr);
+  if (!renderer) return fail(renderer.error());
+  result.m_renderer = std::move(renderer).value();
+
+  for (const RegistrationView& view : views) {
+    const CameraIntrinsics& in = view.camera.intrinsics();
+    if (in.cols != view.xray.cols || in.rows != view.xray.rows) {
+      return fail(fmt::format("view '{}': the camera's detector is {}x{} pixels but the X-ray is {}x{}; fix the view "
+                              "file's detector size",
+                              view.name, in.cols, in.rows, view.xray.cols, view.xray.rows));
+    }
+    XrayImage xray = view.xray;
+    xray.camera = view.camera;
+    XrayPreparationOptions preparation = options.preparation;
+    preparation.spheres.insert(preparation.spheres.end(), view.spheres.begin(), view.spheres.end());
+    auto prepared = XrayPreparation(preparation).prepare(xray);
+    if (!prepared) return fail(fmt::format("view '{}': {}", view.name, prepared.error()));
+
+    // A constant X-ray (over its valid pixels) carries no information to register against.
+    const PyramidLevel& level0 = prepared.value().pyramid.level(0);
+    float lo = std::numeric_limits<float>::infinity();
+    float hi = -lo;
+    for (std::size_t i = 0; i < level0.image.pixels.size(); ++i) {
+      if (!level0.mask.valid[i]) continue;
+      lo = std::min(lo, level0.image.pixels[i]);
+      hi = std::max(hi, level0.image.pixels[i]);
+    }
+    if (!(hi > lo)) {
+      return fail(fmt::format("view '{}': the X-ray is constant ({}) over its {} valid pixels; there is nothing to "
+                              "register against (check the image file)",
+                              view.name, lo, level0.mask.validCount()));
+    }
+    result.m_views.push_back(View{view.name, view.camera, std::move(prepared).value(), {}});
+  }
+
+  auto bone = BoneSurface::extract(ct, options.boneThreshold_hu);
+  if (bone) {
+    result.m_centre_ct_mm = bone.value().centroid_ct_mm();
+    result.m_boneRadius_mm = bone.value().radius_mm();
+    result.m_bone = std::move(bone).value();
+  } else {
+    const Eigen::Vector3d extent_mm = ct.dims().cast<double>().cwiseProduct(ct.spacing_mm());
+    result.m_centre_ct_mm = ct.centre_lps_mm();
+    result.m_boneRadius_mm = 0.25 * extent_mm.norm();
+  }
+  auto scales = PoseOptimizer::scalesForBoneRadius(result.m_boneRadius_mm);
+  if (!scales) return fail("bone radius: " + scales.error());
+  result.m_scales = scales.value();
+  Result<RegistrationCase> out(std::move(result));
+  if (!bone) {
+    out.addWarning(fmt::format("no bone surface at {} HU ({}); rotating about the volume centre", options.boneThreshold_hu,
+                               bone.error()));
+  }
+  return out;
+}
+
+Result<const DynamicRoiSelector*> RegistrationCase::selector(std::size_t v, int level, int windowSize) {
+  if (v >= m_views.size()) return fail(fmt::format("view index {} out of range (there are {})", v, m_views.size()));
+  View& view = m_views[v];
+  if (level < 0 || level >= view.prepared.pyramid.levelCount()) {
+    return fail(fmt::format("view '{}': pyramid level {} does not exist; use 0 to {}", view.name, level,
+                            view.prepared.pyramid.levelCount() - 1));
+  }
+  const auto key = std::make_pair(level, windowSize);
+  auto found = view.selectors.find(key);
+  if (found == view.selectors.end()) {
+    const PyramidLevel& pyramidLevel = view.prepared.pyramid.level(level);
+    auto created = DynamicRoiSelector::create(pyramidLevel.image, pyramidLevel.mask, windowSize);
+    if (!created) return fail(fmt::format("view '{}', level {}: {}", view.name, level, created.error()));
+    found = view.selectors.emplace(key, std::move(created).value()).first;
+  }
+  return &found->second;
+}
+
+Result<RoiSelection> RegistrationCase::rois(std::size_t v, int level, int windowSize, double targetFraction) {
+  auto selector = this->selector(v, level, windowSize);
+  if (!selector) return fail(selector.error());
+  auto selection = selector.value()->selectFraction(targetFraction);
+  if (!selection) return fail(fmt::format("view '{}', level {}: {}", m_views[v].name, level, selection.error()));
+  return selection;
+}
+
+Result<RoiSelection> RegistrationCase::allWindows(std::size_t v, int level, int windowSize) {
+  auto selector = this->selector(v, level, windowSize);
+  if (!selector) return fail(selector.error());
+  return selector.value()->selectAll();
+}
+
+Status RegistrationCase::checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const {
+  for (const View& view : m_views) {
+    const int usedLevel = std::clamp(level, 0, view.prepared.pyramid.levelCount() - 1);
+    const PixelIndexList pixels = view.prepared.pyramid.level(usedLevel).mask.pixelList();
+    auto values = m_renderer->renderPixels(view.camera, T_world_from_ct, usedLevel, pixels);
+    if (!values) return fail(fmt::format("view '{}': {}", view.name, values.error()));
+    const bool empty = std::all_of(values.value().begin(), values.value().end(), [](float x) { return x == 0.0f; });
+    if (empty) {
+      return fail(fmt::format("view '{}': the CT at the initial pose projects outside the X-ray's {} valid pixels (the "
+                              "DRR is empty there), so DRR and X-ray do not overlap; check the initial pose, the "
+                              "landmarks or the view's camera",
+                              view.name, pixels.size()));
+    }
+  }
+  return Ok{};
+}
+
+Eigen::Isometry3d RegistrationCase::poseTransform(const PoseVector& params) const {
+  return RigidPose::toTransform(PoseParameters::fromVector(params), m_centre_ct_mm);
+}
+
+}  // namespace fct

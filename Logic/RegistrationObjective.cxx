@@ -1,0 +1,122 @@
+#include "RegistrationObjective.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "GradientCorrelationSimilarity.h"
+#include "NccSimilarity.h"
+#include "VlncSimilarity.h"
+
+namespace fct {
+
+Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
+                                                            const RegistrationStage& stage) {
+  RegistrationObjective objective;
+  objective.m_renderer = &registrationCase.renderer();
+  objective.m_level = stage.level;
+  const int level = stage.level;
+  auto where = [&](std::size_t v) { return fmt::format("stage '{}', view '{}'", stage.name, registrationCase.viewName(v)); };
+  if (level < 0 || level >= registrationCase.levelCount()) {
+    return fail(fmt::format("stage '{}' uses pyramid level {} but the X-rays have levels 0 to {}; change the preset or "
+                            "prepare more levels",
+                            stage.name, level, registrationCase.levelCount() - 1));
+  }
+  for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
+    const PyramidLevel& pyramidLevel = registrationCase.prepared(v).pyramid.level(level);
+    View view;
+    view.camera = registrationCase.camera(v);
+    const std::size_t validCount = pyramidLevel.mask.validCount();
+
+    // The pixel set: windows for VLNC and for ROIs, the valid pixels otherwise.
+    const bool windows = stage.metric == SimilarityMetric::Vlnc || stage.pixels.kind == PixelSetKind::Rois;
+    RoiSelection selection;
+    if (windows) {
+      auto selected = stage.pixels.kind == PixelSetKind::Rois
+                          ? registrationCase.rois(v, level, stage.pixels.windowSize, stage.pixels.targetFraction)
+                          : registrationCase.allWindows(v, level, stage.pixels.windowSize);
+      if (!selected) return fail(fmt::format("stage '{}': {}", stage.name, selected.error()));
+      selection = std::move(selected).value();
+      view.pixels = selection.pixels;
+    } else {
+      view.pixels = pyramidLevel.mask.pixelList();
+    }
+    if (view.pixels.empty()) {
+      return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}); reduce the masks or use a "
+                              "finer level",
+                              where(v), level));
+    }
+    view.keptFraction = validCount ? static_cast<double>(view.pixels.size()) / static_cast<double>(validCount) : 0.0;
+
+    switch (stage.metric) {
+      case SimilarityMetric::Ncc: {
+        auto metric = NccSimilarity::create(pyramidLevel.image, view.pixels);
+        if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
+        view.metric = std::make_unique<NccSimilarity>(std::move(metric).value());
+        break;
+      }
+      case SimilarityMetric::Vlnc: {
+        auto metric = VlncSimilarity::create(pyramidLevel.image, selection);
+        if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
+        view.metric = std::make_unique<VlncSimilarity>(std::move(metric).value());
+        break;
+      }
+      case SimilarityMetric::GradientCorrelation: {
+        auto metric = GradientCorrelationSimilarity::create(pyramidLevel.image, view.pixels);
+        if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
+        view.metric = std::make_unique<GradientCorrelationSimilarity>(std::move(metric).value());
+        view.wholeLevel = true;
+        break;
+      }
+    }
+    view.drr = FloatImage::filled(pyramidLevel.image.cols, pyramidLevel.image.rows, 0.0f);
+    view.values.reserve(view.pixels.size());
+    objective.m_views.push_back(std::move(view));
+  }
+  objective.m_lastPerView.assign(objective.m_views.size(), 0.0);
+  return objective;
+}
+
+Result<double> RegistrationObjective::similarity(const Eigen::Isometry3d& T_world_from_ct) {
+  tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
+    View& view = m_views[v];
+    if (view.wholeLevel) {
+      view.status = m_renderer->render(view.camera, T_world_from_ct, m_level, view.drr);
+    } else {
+      view.status = m_renderer->renderPixels(view.camera, T_world_from_ct, m_level, view.pixels, view.values);
+      if (view.status) {
+        for (std::size_t i = 0; i < view.pixels.size(); ++i) view.drr.pixels[view.pixels[i]] = view.values[i];
+      }
+    }
+    if (!view.status) return;
+    auto score = view.metric->evaluate(view.drr);
+    if (!score) {
+      view.status = fail(score.error());
+      return;
+    }
+    view.score = score.value();
+  });
+  m_drrCount += static_cast<long>(m_views.size());
+  double sum = 0.0;
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    if (!m_views[v].status) return fail(m_views[v].status.error());
+    sum += m_views[v].score;
+    m_lastPerView[v] = m_views[v].score;
+  }
+  return sum / static_cast<double>(m_views.size());
+}
+
+std::vector<double> RegistrationObjective::keptFractions() const {
+  std::vector<double> fractions;
+  for (const View& view : m_views) fractions.push_back(view.keptFraction);
+  return fractions;
+}
+
+std::vector<std::size_t> RegistrationObjective::renderedPixelCounts() const {
+  std::vector<std::size_t> counts;
+  for (const View& view : m_views) {
+    counts.push_back(view.wholeLevel ? view.drr.pixels.size() : view.pixels.size());
+  }
+  return counts;
+}
+
+}  // namespace fct

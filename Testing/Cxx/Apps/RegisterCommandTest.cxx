@@ -1,0 +1,163 @@
+// fluoroct register: end to end on a case made by `fluoroct phantom`, `views` and `simulate`, from a pose file and
+// from landmarks; and its errors.
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+
+#include "JsonDocument.h"
+#include "LandmarkFile.h"
+#include "PoseFile.h"
+#include "TestSupport.h"
+#include "ViewFile.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A small simulated phantom case in `dir`: ct.nrrd, views.json (3 views, 160x160 at 2 mm), sim/ (images, view file,
+/// truth pose). Returns the truth pose.
+Eigen::Isometry3d makeCase(const fs::path& dir) {
+  auto run = fct::test::runCli(fmt::format("phantom --out '{}' --dims 80 80 60 --spacing-mm 2", (dir / "ct.nrrd").string()));
+  EXPECT_EQ(run.exitCode, 0) << run.err;
+  run = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --detector 160x160 --pixel-mm 2 --sid-mm 1000 "
+                                      "--sad-mm 700",
+                                      (dir / "ct.nrrd").string(), (dir / "views.json").string()));
+  EXPECT_EQ(run.exitCode, 0) << run.err;
+  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
+  truth.linear() = Eigen::AngleAxisd(0.05, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  truth.translation() = Eigen::Vector3d(2.0, -1.0, 3.0);
+  EXPECT_TRUE(fct::PoseFile::write(truth, dir / "truth.json").ok());
+  run = fct::test::runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --noise-photons 3000",
+                                      (dir / "ct.nrrd").string(), (dir / "views.json").string(),
+                                      (dir / "truth.json").string(), (dir / "sim").string()));
+  EXPECT_EQ(run.exitCode, 0) << run.err;
+  return truth;
+}
+
+Eigen::Isometry3d perturbed(const Eigen::Isometry3d& truth) {
+  Eigen::Isometry3d start = truth;
+  start.translation() += Eigen::Vector3d(2.0, -1.5, 1.0);
+  start.linear() = Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitZ()).toRotationMatrix() * start.linear();
+  return start;
+}
+
+bool oneErrorLine(const fct::test::ProcessResult& run) {
+  return run.exitCode == 2 && run.err.rfind("error: ", 0) == 0 &&
+         std::count(run.err.begin(), run.err.end(), '\n') == 1;
+}
+
+}  // namespace
+
+TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
+  const auto run = fct::test::runCli(fmt::format(
+      "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --out '{}' --progress --overlays '{}'",
+      (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(),
+      (dir / "result.json").string(), (dir / "overlays").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("registered"), std::string::npos) << run.out;
+  EXPECT_NE(run.err.find("stage 1/4"), std::string::npos) << "progress bar on stderr: " << run.err;
+
+  auto result = fct::JsonDocument::parse(dir / "result.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  const auto& json = result.value();
+  auto registered = fct::PoseFile::read(dir / "result.json");  // T_world_from_ct reads like a pose file
+  ASSERT_TRUE(registered.ok()) << registered.error();
+  EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 0.5);
+  EXPECT_LT(Eigen::AngleAxisd(registered.value().linear() * truth.linear().transpose()).angle() * 180.0 / M_PI, 0.3);
+  EXPECT_FALSE(json["cancelled"].get<bool>());
+  ASSERT_EQ(json["stages"].size(), 4u);
+  for (const auto& stage : json["stages"]) {
+    for (const char* key : {"name", "seconds", "drrs", "similarity", "kept_fraction"}) {
+      EXPECT_TRUE(stage.contains(key)) << key;
+    }
+    EXPECT_EQ(stage["kept_fraction"].size(), 3u);
+  }
+  EXPECT_GT(json["total_seconds"].get<double>(), 0.0);
+  EXPECT_EQ(json["options"]["preset"], "fast");
+  EXPECT_EQ(json["options"]["seed"], 3);
+  EXPECT_EQ(json["options"]["method"], "siddon");
+  EXPECT_EQ(json["options"]["schedule"]["stages"].size(), 4u);
+  EXPECT_EQ(json["initial_pose"]["source"], "pose file");
+  EXPECT_EQ(json["initial_pose"]["T_world_from_ct"].size(), 4u);
+  for (const char* view : {"ap", "lateral", "oblique45"}) {
+    EXPECT_GT(fs::file_size(dir / "overlays" / (std::string(view) + ".png")), 1000u) << view;
+  }
+}
+
+TEST(RegisterCommand, EstimatesTheInitialPoseFromLandmarks) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  auto views = fct::ViewFile::read(dir / "sim" / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  const std::vector<fct::CtLandmark> ct{{"A", {30, 10, 20}}, {"B", {-25, 15, -10}}, {"C", {5, -30, 25}},
+                                        {"D", {-10, -5, -30}}, {"E", {20, 25, -20}}};
+  std::map<std::string, std::vector<fct::ImageLandmark>> clicks;
+  for (const auto& view : views.value()) {
+    for (const auto& landmark : ct) {
+      clicks[view.name].push_back({landmark.name, view.camera.project(truth * landmark.p_ct_mm) + Eigen::Vector2d(0.6, -0.4)});
+    }
+  }
+  ASSERT_TRUE(fct::LandmarkFile::writeCt(ct, dir / "points.mrk.json").ok());
+  ASSERT_TRUE(fct::LandmarkFile::writeImage(clicks, dir / "clicks.json").ok());
+  std::ofstream(dir / "lm.json") << R"({"ct": "points.mrk.json", "image": "clicks.json"})";
+  const auto run = fct::test::runCli(fmt::format(
+      "register --ct '{}' --views '{}' --landmarks '{}' --preset fast --local-only --out '{}'",
+      (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "lm.json").string(),
+      (dir / "result.json").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  auto result = fct::JsonDocument::parse(dir / "result.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  EXPECT_EQ(result.value()["initial_pose"]["source"], "landmarks");
+  EXPECT_EQ(result.value()["initial_pose"]["residuals"].size(), 5u);
+  EXPECT_EQ(result.value()["options"]["ablation"][0], "local-only");
+  auto registered = fct::PoseFile::read(dir / "result.json");
+  ASSERT_TRUE(registered.ok()) << registered.error();
+  EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 0.5);
+}
+
+TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(truth, dir / "init.json").ok());
+  const std::string base = fmt::format("register --ct '{}' --views '{}'", (dir / "ct.nrrd").string(),
+                                       (dir / "sim" / "views.json").string());
+  const std::string init = fmt::format(" --init '{}'", (dir / "init.json").string());
+
+  const auto noInit = fct::test::runCli(base);
+  EXPECT_TRUE(oneErrorLine(noInit)) << noInit.err;
+  EXPECT_NE(noInit.err.find("--init"), std::string::npos) << noInit.err;
+
+  const auto badPreset = fct::test::runCli(base + init + " --preset fastest");
+  EXPECT_TRUE(oneErrorLine(badPreset)) << badPreset.err;
+  EXPECT_NE(badPreset.err.find("fast, paper"), std::string::npos) << badPreset.err;
+
+  const auto badMethod = fct::test::runCli(base + init + " --method magic");
+  EXPECT_TRUE(oneErrorLine(badMethod)) << badMethod.err;
+
+  Eigen::Isometry3d far = truth;
+  far.translation().z() += 900.0;
+  ASSERT_TRUE(fct::PoseFile::write(far, dir / "far.json").ok());
+  const auto noOverlap = fct::test::runCli(base + fmt::format(" --init '{}' --out '{}'", (dir / "far.json").string(),
+                                                              (dir / "never.json").string()));
+  EXPECT_TRUE(oneErrorLine(noOverlap)) << noOverlap.err;
+  EXPECT_NE(noOverlap.err.find("do not overlap"), std::string::npos) << noOverlap.err;
+  EXPECT_FALSE(fs::exists(dir / "never.json")) << "nothing written on failure";
+
+  // Landmarks clicked in a view the view file does not have.
+  ASSERT_TRUE(fct::LandmarkFile::writeCt({{"A", {0, 0, 0}}, {"B", {10, 0, 0}}, {"C", {0, 10, 0}}, {"D", {0, 0, 10}}},
+                                         dir / "points.mrk.json")
+                  .ok());
+  ASSERT_TRUE(fct::LandmarkFile::writeImage({{"nosuchview", {{"A", {1, 1}}, {"B", {2, 2}}, {"C", {3, 1}}, {"D", {5, 5}}}}},
+                                            dir / "clicks.json")
+                  .ok());
+  std::ofstream(dir / "lm.json") << R"({"ct": "points.mrk.json", "image": "clicks.json"})";
+  const auto badView = fct::test::runCli(base + fmt::format(" --landmarks '{}'", (dir / "lm.json").string()));
+  EXPECT_TRUE(oneErrorLine(badView)) << badView.err;
+  EXPECT_NE(badView.err.find("nosuchview"), std::string::npos) << badView.err;
+}
