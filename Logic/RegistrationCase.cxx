@@ -18,6 +18,11 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   auto drrVolume = DrrVolume::create(ct);
   if (!drrVolume) return fail("CT: " + drrVolume.error());
   result.m_drrVolume = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
+  if (options.drr.method == DrrMethod::Transgraph) {
+    // One renderer serves every view here, while a Transgraph table belongs to one view and expected pose.
+    return fail("registration with the transgraph DRR method is not available yet (it needs one table per view "
+                "around the initial pose); use --method siddon or raycast");
+  }
   auto renderer = DrrRendererFactory::create(result.m_drrVolume, options.drr);
   if (!renderer) return fail(renderer.error());
   result.m_renderer = std::move(renderer).value();

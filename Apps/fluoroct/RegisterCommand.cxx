@@ -15,7 +15,7 @@
 
 #include "CliSupport.h"
 #include "ContourOverlay.h"
-#include "CtVolumeReader.h"
+#include "CtLoader.h"
 #include "JsonDocument.h"
 #include "JsonReader.h"
 #include "LandmarkFile.h"
@@ -194,7 +194,7 @@ int runRegister(const Options& o) {
   if (!viewSpecs) return reportError(viewSpecs.error());
   auto initial = initialPose(o, viewSpecs.value());
   if (!initial) return reportError(initial.error());
-  auto ct = CtVolumeReader::read(o.ct);
+  auto ct = CtLoader::load(o.ct);
   if (!ct) return reportError(ct.error());
   for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
 
