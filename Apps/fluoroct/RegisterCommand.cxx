@@ -42,6 +42,7 @@ struct Options {
   std::string method = "siddon";
   std::string out;
   std::string overlays;
+  std::string truth;  ///< optional known true pose (simulated cases): the pose error is reported
   bool progress = false;
   bool noFieldOfView = false;
   RegistrationAblation ablation;
@@ -194,6 +195,12 @@ int runRegister(const Options& o) {
   if (!viewSpecs) return reportError(viewSpecs.error());
   auto initial = initialPose(o, viewSpecs.value());
   if (!initial) return reportError(initial.error());
+  std::optional<Eigen::Isometry3d> T_truth;
+  if (!o.truth.empty()) {
+    auto truth = PoseFile::read(o.truth);
+    if (!truth) return reportError(truth.error());
+    T_truth = truth.value();
+  }
   auto ct = CtLoader::load(o.ct);
   if (!ct) return reportError(ct.error());
   for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
@@ -242,8 +249,22 @@ int runRegister(const Options& o) {
       if (!written) return reportError(fmt::format("overlay of view '{}': {}", view.name, written.error()));
     }
   }
+  nlohmann::ordered_json json = resultJson(r, o, initial.value().second);
+  std::string errorLine;
+  if (T_truth && registrationCase.value().bone()) {
+    // The pose error as the paper measures it: mean (max) distance of the bone surface points, final vs. truth.
+    const BoneSurface& bone = *registrationCase.value().bone();
+    const double initialMean = bone.meanDistance_mm(r.T_initial, *T_truth);
+    const double finalMean = bone.meanDistance_mm(r.T_world_from_ct, *T_truth);
+    const double finalMax = bone.maxDistance_mm(r.T_world_from_ct, *T_truth);
+    json["error_vs_truth"] = {{"initial_mean_surface_mm", initialMean},
+                              {"final_mean_surface_mm", finalMean},
+                              {"final_max_surface_mm", finalMax}};
+    errorLine = fmt::format("pose error vs truth: mean bone-surface distance {:.3f} mm -> {:.3f} mm (max {:.3f} mm)\n",
+                            initialMean, finalMean, finalMax);
+  }
   if (!o.out.empty()) {
-    const Status written = JsonDocument::write(resultJson(r, o, initial.value().second), o.out);
+    const Status written = JsonDocument::write(json, o.out);
     if (!written) return reportError(written.error());
   }
   for (const StageReport& s : r.stages) {
@@ -253,6 +274,7 @@ int runRegister(const Options& o) {
   }
   fmt::print("{} in {:.2f} s, {} DRRs ({} method){}\n", r.cancelled ? "cancelled" : "registered", r.totalSeconds,
              r.totalDrrs, r.drrMethod, o.out.empty() ? "" : fmt::format("; wrote {}", o.out));
+  fmt::print("{}", errorLine);
   return 0;
 }
 
@@ -279,6 +301,8 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--method", options->method, "DRR method: siddon, raycast (or any method the build offers)")
       ->capture_default_str();
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
+  command->add_option("--truth", options->truth,
+                      "Known true pose file (simulated cases): report the mean/max bone-surface distance to it");
   command->add_option("--overlays", options->overlays,
                       "Folder for one PNG per view (<view>.png) with the bone outlines at the initial (red) and final "
                       "(green) pose over the X-ray");

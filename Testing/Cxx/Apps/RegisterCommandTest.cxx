@@ -55,10 +55,12 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   const fs::path dir = fct::test::scratchDir();
   const Eigen::Isometry3d truth = makeCase(dir);
   ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
+  ASSERT_TRUE(fct::PoseFile::write(truth, dir / "truth.json").ok());
   const auto run = fct::test::runCli(fmt::format(
-      "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --out '{}' --progress --overlays '{}'",
+      "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --out '{}' --progress --overlays '{}' "
+      "--truth '{}'",
       (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(),
-      (dir / "result.json").string(), (dir / "overlays").string()));
+      (dir / "result.json").string(), (dir / "overlays").string(), (dir / "truth.json").string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("registered"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("stage 1/4"), std::string::npos) << "progress bar on stderr: " << run.err;
@@ -71,6 +73,9 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 0.5);
   EXPECT_LT(Eigen::AngleAxisd(registered.value().linear() * truth.linear().transpose()).angle() * 180.0 / M_PI, 0.3);
   EXPECT_FALSE(json["cancelled"].get<bool>());
+  EXPECT_NE(run.out.find("pose error vs truth"), std::string::npos) << run.out;
+  EXPECT_GT(json["error_vs_truth"]["initial_mean_surface_mm"].get<double>(), 1.0);
+  EXPECT_LT(json["error_vs_truth"]["final_mean_surface_mm"].get<double>(), 0.5);
   ASSERT_EQ(json["stages"].size(), 4u);
   for (const auto& stage : json["stages"]) {
     for (const char* key : {"name", "seconds", "drrs", "similarity", "kept_fraction"}) {
