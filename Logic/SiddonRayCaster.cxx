@@ -16,7 +16,7 @@ namespace {
 constexpr long kMinRunLength = 3;
 }  // namespace
 
-SiddonRayCaster::SiddonRayCaster(std::shared_ptr<const DrrVolume> volume) : DrrRenderer(std::move(volume)) {}
+SiddonRayCaster::SiddonRayCaster(std::shared_ptr<const DrrVolume> volume) : IndexSpaceRayCaster(std::move(volume)) {}
 
 inline double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk,
                                             double length_mm) const {
@@ -158,20 +158,6 @@ inline double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const 
   }
   if (t < t1) sum += (t1 - t) * data[offset];
   return sum * length_mm;
-}
-
-double SiddonRayCaster::integrate(const Eigen::Vector3d& from_ct_mm, const Eigen::Vector3d& to_ct_mm) const {
-  const Eigen::Affine3d& T = volume().T_ijk_from_ct();
-  return integrateIjk(T * from_ct_mm, T * to_ct_mm, (to_ct_mm - from_ct_mm).norm());
-}
-
-void SiddonRayCaster::integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct,
-                                      const std::int32_t* pixels, std::size_t count, float* values) const {
-  const DrrRayGeometry geometry(levelCamera, T_world_from_ct, volume().T_ijk_from_ct());
-  geometry.integratePixels(pixels, count, values,
-                           [this](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double length_mm) {
-                             return integrateIjk(a, b, length_mm);
-                           });
 }
 
 }  // namespace fct

@@ -8,27 +8,20 @@
 #include <Eigen/Core>
 #include <memory>
 
-#include "DrrRenderer.h"
+#include "IndexSpaceRayCaster.h"
 
 namespace fct {
 
 /// Exact voxel-traversal DRR renderer.
-class SiddonRayCaster final : public DrrRenderer {
+class SiddonRayCaster final : public IndexSpaceRayCaster<SiddonRayCaster> {
  public:
   /// A renderer of `volume` (must not be null).
   explicit SiddonRayCaster(std::shared_ptr<const DrrVolume> volume);
 
   std::string_view methodName() const override { return "siddon"; }
 
-  /// Exact line integral of the volume's values along the segment from_ct_mm -> to_ct_mm (CT frame, LPS mm):
-  /// dimensionless for attenuation values, value·mm for raw values; 0 if the segment misses the volume.
-  double integrate(const Eigen::Vector3d& from_ct_mm, const Eigen::Vector3d& to_ct_mm) const;
-
- protected:
-  void integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct, const std::int32_t* pixels,
-                       std::size_t count, float* values) const override;
-
  private:
+  friend class IndexSpaceRayCaster<SiddonRayCaster>;
   /// Integral along the index-space segment a_ijk -> b_ijk whose physical length is length_mm.
   double integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk, double length_mm) const;
 };

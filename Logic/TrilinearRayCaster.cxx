@@ -9,7 +9,7 @@
 namespace fct {
 
 TrilinearRayCaster::TrilinearRayCaster(std::shared_ptr<const DrrVolume> volume, double step_mm)
-    : DrrRenderer(std::move(volume)),
+    : IndexSpaceRayCaster(std::move(volume)),
       m_step_mm(std::isfinite(step_mm) && step_mm > 0.0 ? step_mm : defaultStep_mm(this->volume())) {
   const DrrVolume& vol = this->volume();
   m_clipMin_ijk = (vol.contentBoxMin_ijk().array() - 0.5).max(vol.boxMin_ijk().array());
@@ -66,20 +66,6 @@ inline double TrilinearRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, con
     sum += c0 + fz * (c1 - c0);
   }
   return sum * dt * length_mm;
-}
-
-double TrilinearRayCaster::integrate(const Eigen::Vector3d& from_ct_mm, const Eigen::Vector3d& to_ct_mm) const {
-  const Eigen::Affine3d& T = volume().T_ijk_from_ct();
-  return integrateIjk(T * from_ct_mm, T * to_ct_mm, (to_ct_mm - from_ct_mm).norm());
-}
-
-void TrilinearRayCaster::integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct,
-                                         const std::int32_t* pixels, std::size_t count, float* values) const {
-  const DrrRayGeometry geometry(levelCamera, T_world_from_ct, volume().T_ijk_from_ct());
-  geometry.integratePixels(pixels, count, values,
-                           [this](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double length_mm) {
-                             return integrateIjk(a, b, length_mm);
-                           });
 }
 
 }  // namespace fct

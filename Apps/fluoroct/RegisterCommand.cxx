@@ -23,8 +23,7 @@
 #include "PoseFile.h"
 #include "Registration.h"
 #include "ViewFile.h"
-#include "XrayDicomReader.h"
-#include "XrayImageFileReader.h"
+#include "XrayLoader.h"
 
 namespace fct::cli {
 
@@ -57,11 +56,7 @@ Result<XrayImage> readImage(const ViewSpec& view) {
                             "file)",
                             view.name));
   }
-  std::string extension = view.imagePath.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  auto image = (extension == ".png" || extension == ".tif" || extension == ".tiff")
-                   ? XrayImageFileReader::read(view.imagePath)
-                   : XrayDicomReader::read(view.imagePath, view.frame);
+  auto image = XrayLoader::load(view.imagePath, view.frame);
   if (!image) return fail(fmt::format("view '{}': {}", view.name, image.error()));
   return image;
 }
