@@ -43,7 +43,10 @@ Status writeAll(int fd, const std::string& contents) {
 
 Result<std::string> TextFile::read(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return fail(fmt::format("'{}' not found", path.string()));
+  if (!std::filesystem::exists(path, ec)) {
+    return fail(fmt::format("'{}' not found; check the path (a relative path is taken from the current folder)",
+                            path.string()));
+  }
   if (std::filesystem::is_directory(path, ec)) {
     return fail(fmt::format("'{}' is a folder, not a file", path.string()));
   }

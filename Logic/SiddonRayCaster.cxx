@@ -18,7 +18,7 @@ constexpr long kMinRunLength = 3;
 
 SiddonRayCaster::SiddonRayCaster(std::shared_ptr<const DrrVolume> volume) : IndexSpaceRayCaster(std::move(volume)) {}
 
-inline double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk,
+double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk,
                                             double length_mm) const {
   const DrrVolume& vol = volume();
   const Eigen::Vector3d d = b_ijk - a_ijk;

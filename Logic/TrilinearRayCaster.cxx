@@ -20,7 +20,7 @@ double TrilinearRayCaster::defaultStep_mm(const DrrVolume& volume) {
   return 0.5 * volume.values().spacing_mm().minCoeff();
 }
 
-inline double TrilinearRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk,
+double TrilinearRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk,
                                                double length_mm) const {
   const DrrVolume& vol = volume();
   const Eigen::Vector3d d = b_ijk - a_ijk;

@@ -15,13 +15,13 @@
 #include <vector>
 
 #include "BoneSurface.h"
+#include "PoseOffset.h"
 #include "DrrRendererFactory.h"
 #include "DrrXraySimulator.h"
 #include "PoseOptimizer.h"
 #include "RegistrationCase.h"
 #include "Result.h"
 #include "RigidPose.h"
-#include "SeededRandom.h"
 #include "StandardViews.h"
 #include "Volume.h"
 
@@ -91,24 +91,11 @@ inline Result<KnownTruthCase> simulateCase(Volume ct, const KnownTruthOptions& o
   c.ct = std::move(ct);
   return c;
 }
-/// A start pose whose mean bone-surface distance from `T_truth` is `distance_mm`: the truth's parameters plus a
-/// random direction (uniform on the sphere in scaled units) scaled by bisection. Deterministic for a seed.
+/// A start pose whose mean bone-surface distance from `T_truth` is `distance_mm` (PoseOffset's random offset about
+/// the case's bone). Deterministic for a seed.
 inline Eigen::Isometry3d startPose(const RegistrationCase& registrationCase, const Eigen::Isometry3d& T_truth,
                                    double distance_mm, std::uint32_t seed) {
-  const BoneSurface& bone = *registrationCase.bone();
-  const PoseVector truth = RigidPose::fromTransform(T_truth, registrationCase.rotationCentre_ct_mm()).value().asVector();
-  SeededRandom random(seed);
-  PoseVector direction;
-  for (int k = 0; k < 6; ++k) direction[k] = random.normal();
-  direction = direction.normalized().cwiseProduct(registrationCase.scales());
-  auto at = [&](double s) { return registrationCase.poseTransform(truth + s * direction); };
-  double lo = 0.0, hi = 1.0;
-  while (bone.meanDistance_mm(at(hi), T_truth) < distance_mm) hi *= 2.0;
-  for (int i = 0; i < 50; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (bone.meanDistance_mm(at(mid), T_truth) < distance_mm ? lo : hi) = mid;
-  }
-  return at(0.5 * (lo + hi));
+  return PoseOffset::randomAtSurfaceDistance(*registrationCase.bone(), T_truth, distance_mm, seed).value();
 }
 
 }  // namespace fct::test
