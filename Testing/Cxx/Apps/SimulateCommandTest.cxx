@@ -131,3 +131,62 @@ TEST(SimulateCommand, FailsCleanlyOnBadInputs) {
   EXPECT_FALSE(std::filesystem::exists(dir / "v7.json"));
   EXPECT_FALSE(std::filesystem::exists(dir / "vd.json"));
 }
+
+TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegradedCt) {
+  const auto dir = workDir();
+  makeInputs(dir);
+  const auto out = dir / "physical";
+  const auto run = fct::test::runCli(fmt::format(
+      "simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --model physical --kvp 75 --dose 2000 --psf-px 0.8 "
+      "--pincushion 0.03 --vignetting 0.2 --collimator 1.1 --kwires 1 --screws 1 --plate --spheres --sphere-pitch-mm 50 "
+      "--ct-slice-mm 8",
+      (dir / "ct.nrrd").string(), (dir / "views.json").string(), (dir / "pose.json").string(), out.string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  auto views = fct::ViewFile::read(out / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  ASSERT_EQ(views.value().size(), 3u);
+  for (const auto& view : views.value()) {
+    SCOPED_TRACE(view.name);
+    auto image = fct::XrayImageFileReader::read(view.imagePath);
+    ASSERT_TRUE(image.ok()) << image.error();
+    const auto [lo, hi] = std::minmax_element(image.value().pixels.begin(), image.value().pixels.end());
+    EXPECT_EQ(*lo, 0.0f);       // outside the collimator
+    EXPECT_GT(*hi, 30000.0f);   // the exposure reference maps to the gain, 50000
+    EXPECT_FALSE(view.calibrationSpheres.empty());
+    EXPECT_TRUE(std::filesystem::exists(out / (view.name + "_distortion_dcol.nrrd")));
+  }
+  auto degraded = fct::test::runCli(fmt::format("info '{}'", (out / "ct_registration.nrrd").string()));
+  ASSERT_EQ(degraded.exitCode, 0) << degraded.err;
+  EXPECT_NE(degraded.out.find("4 x 4 x 8 mm"), std::string::npos) << degraded.out;
+  std::ifstream parameters(out / "simulation.json");
+  const std::string text((std::istreambuf_iterator<char>(parameters)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"model\": \"physical\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"tube_voltage_kvp\": 75"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"slice_spacing_mm\": 8"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"kind\": \"plate\""), std::string::npos) << text;
+}
+
+TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
+  const auto dir = workDir();
+  makeInputs(dir);
+  const auto out = dir / "case";
+  const std::string base = fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'", (dir / "ct.nrrd").string(),
+                                       (dir / "views.json").string(), (dir / "pose.json").string(), out.string());
+  for (const std::string& extra :
+       {std::string(" --model physical --kvp 200"), std::string(" --model physical --dose -1"),
+        std::string(" --model physical --pincushion 0.5"), std::string(" --model physical --method raycast"),
+        std::string(" --kwires 2"), std::string(" --model xray"), std::string(" --model physical --ct-slice-mm 2")}) {
+    SCOPED_TRACE(extra);
+    const auto run = fct::test::runCli(base + extra);
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_EQ(run.err.rfind("error: ", 0), 0u) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out)) << "failed runs must not create the case folder";
+  std::ofstream(dir / "scaled.json") << R"({"T_world_from_ct": [[2,0,0,0],[0,2,0,0],[0,0,2,0],[0,0,0,1]]})";
+  const auto notRigid = fct::test::runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --model physical",
+                                                      (dir / "ct.nrrd").string(), (dir / "views.json").string(),
+                                                      (dir / "scaled.json").string(), out.string()));
+  EXPECT_EQ(notRigid.exitCode, 2);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
