@@ -36,10 +36,12 @@ struct RenderedView {
   double referenceSignal = 1.0;             ///< noiseless signal mapped to `gain` (1 = an unattenuated ray)
 };
 
+/// The spectrum settings inside the simulator's options.
 SpectrumOptions spectrumOptions(const FluoroscopyOptions& o) {
   return {o.tubeVoltage_kvp, o.filtration_mmAl, o.spectrumBinWidth_keV, o.monochromatic_keV};
 }
 
+/// Checks the detector and placement settings (the spectrum, HU model, distortion and objects check their own).
 Status validate(const FluoroscopyOptions& o) {
   const auto bad = [](double v, double low, double high) { return !(v >= low && v <= high); };
   if (bad(o.photonsPerPixel, 0.0, 1e9)) {
@@ -60,6 +62,7 @@ Status validate(const FluoroscopyOptions& o) {
   return Ok{};
 }
 
+/// Fails unless T's linear part is a proper rotation.
 Status checkRigid(const Eigen::Isometry3d& T) {
   const Eigen::Matrix3d R = T.linear();
   if (!T.matrix().allFinite() || (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-6 || R.determinant() < 0.0) {
@@ -68,6 +71,7 @@ Status checkRigid(const Eigen::Isometry3d& T) {
   return Ok{};
 }
 
+/// Builds the spectrum, attenuation table, tracer and implants shared by every view.
 Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) {
   if (Status valid = validate(options); !valid) return fail(valid.error());
   auto spectrum = XraySpectrum::create(spectrumOptions(options));
@@ -90,9 +94,9 @@ Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) 
   return scene;
 }
 
+/// Renders one view of a prepared scene; the pose must already be checked rigid.
 Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
                                 const FluoroscopyOptions& options, std::uint32_t viewSeed) {
-  if (Status rigid = checkRigid(T_world_from_ct); !rigid) return fail(rigid.error());
   const CameraIntrinsics& in = camera.intrinsics();
   if (in.cols <= 0 || in.rows <= 0) return fail("camera has an empty detector; check the view file");
   std::optional<IntensifierDistortion> distortion;
@@ -234,6 +238,7 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
   return view;
 }
 
+/// Every option, for simulation.json.
 nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
   nlohmann::ordered_json j;
   j["tube_voltage_kvp"] = o.tubeVoltage_kvp;
