@@ -115,16 +115,13 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   command->callback([&action, options, command] {
     const bool physical = options->model == "physical";
-    std::string misplaced;
-    if (physical) {
-      for (const char* name : kDrrOnly) {
-        if (command->count(name) > 0) misplaced = name;
+    const auto firstGiven = [command](const auto& names) -> std::string {
+      for (const char* name : names) {
+        if (command->count(name) > 0) return name;
       }
-    } else {
-      for (const char* name : kPhysicalOnly) {
-        if (command->count(name) > 0) misplaced = name;
-      }
-    }
+      return {};
+    };
+    const std::string misplaced = physical ? firstGiven(kDrrOnly) : firstGiven(kPhysicalOnly);
     action = [options, physical, misplaced] {
       if (options->model != "drr" && options->model != "physical") {
         return reportError(fmt::format("unknown model '{}'; use drr or physical", options->model));
