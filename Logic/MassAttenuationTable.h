@@ -6,7 +6,9 @@
 // Fe) and Table 4 (mixtures: Air, Dry; Water, Liquid; Tissue, Soft (ICRU-44); Bone, Cortical (ICRU-44)), at the
 // tabulated energies 10, 15, 20, 30, 40, 50, 60, 80, 100 and 150 keV. Between them µ/ρ is interpolated linearly in
 // log(µ/ρ) against log(E), as NIST recommends away from absorption edges (none of these materials has an edge in
-// 10–150 keV). Stainless steel is approximated by iron and Ti-6Al-4V by titanium.
+// 10–150 keV). Stainless steel is approximated by iron and Ti-6Al-4V by titanium. The numbers were typed in by hand;
+// the Fe, Al and cortical-bone rows were checked digit by digit against copies of the NIST tables, the soft-tissue and
+// water rows at 40–100 keV, and the Ti row only against published linear coefficients (within ~3 %).
 
 #include <array>
 #include <string_view>
