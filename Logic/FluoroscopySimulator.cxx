@@ -79,7 +79,8 @@ Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) 
   auto tracer = MaterialPathTracer::create(ct, options.materials);
   if (!tracer.ok()) return fail(tracer.error());
   auto implants = ForeignObjectSet::placeNearBone(
-      ct, {options.kwireCount, options.screwCount, options.plate, options.boneThreshold_hu, options.seed});
+      ct, {options.kwireCount, options.screwCount, options.plate, options.gasPocketCount, options.boneThreshold_hu,
+           options.seed});
   if (!implants.ok()) return fail(implants.error());
   Scene scene{std::move(spectrum).value(), {}, std::move(tracer).value(), std::move(implants).value()};
   for (const SpectrumBin& bin : scene.spectrum.bins()) {
@@ -156,6 +157,7 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
       paths = scene.tracer.trace(source_ct, direction_ct);
       scene.implants.accumulate(source_ct, direction_ct, paths);
       spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
+      for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
       view.image.pixels[index] = static_cast<float>(transmissions(paths, transmission));
       exposed[index] = 1;
     }
@@ -262,6 +264,7 @@ nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
   j["kwires"] = o.kwireCount;
   j["screws"] = o.screwCount;
   j["plate"] = o.plate;
+  j["gas_pockets"] = o.gasPocketCount;
   j["calibration_spheres"] = o.calibrationSpheres;
   j["sphere_spacing_mm"] = o.sphereSpacing_mm;
   j["sphere_radius_mm"] = o.sphereRadius_mm;

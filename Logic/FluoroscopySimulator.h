@@ -61,6 +61,7 @@ struct FluoroscopyOptions {
   int kwireCount = 0;                 ///< K-wires (stainless steel, Ø 2 mm, 150 mm) through the bone surface
   int screwCount = 0;                 ///< bone screws (titanium, Ø 4.5 mm × 40 mm shaft, Ø 8 mm head) into the bone
   bool plate = false;                 ///< a bone plate (stainless steel, 100 × 12 × 3.5 mm) on the bone surface
+  int gasPocketCount = 0;             ///< soft-tissue change: bowel-gas pockets (r 8-20 mm) in soft tissue near the bone
   bool calibrationSpheres = false;    ///< a grid of steel spheres fixed to the C-arm near the detector
   double sphereSpacing_mm = 40.0;     ///< grid pitch of the spheres
   double sphereRadius_mm = 1.5;       ///< sphere radius

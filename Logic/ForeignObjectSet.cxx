@@ -94,12 +94,13 @@ Eigen::Vector3d jitter(const Eigen::Vector3d& direction, double maxAngle_rad, Se
 }  // namespace
 
 Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const ImplantOptions& options) {
-  if (options.kwireCount < 0 || options.screwCount < 0 || options.kwireCount > 20 || options.screwCount > 20) {
-    return fail(fmt::format("K-wire and screw counts must be 0..20, got {} and {}", options.kwireCount,
-                            options.screwCount));
+  const auto badCount = [](int n) { return n < 0 || n > 20; };
+  if (badCount(options.kwireCount) || badCount(options.screwCount) || badCount(options.gasPocketCount)) {
+    return fail(fmt::format("K-wire, screw and gas-pocket counts must be 0..20, got {}, {} and {}", options.kwireCount,
+                            options.screwCount, options.gasPocketCount));
   }
   ForeignObjectSet set;
-  if (options.kwireCount == 0 && options.screwCount == 0 && !options.plate) return set;
+  if (options.kwireCount == 0 && options.screwCount == 0 && !options.plate && options.gasPocketCount == 0) return set;
 
   // Bone centroid and surface voxels (bone with a non-bone 6-neighbour; the grid border counts as non-bone).
   const Eigen::Vector3i& dims = ct.dims();
@@ -124,8 +125,8 @@ Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const
     }
   }
   if (surface.empty()) {
-    return fail(fmt::format("no bone (voxels >= {} HU) to place K-wires, screws or a plate on; lower the bone "
-                            "threshold or drop the objects",
+    return fail(fmt::format("no bone (voxels >= {} HU) to place K-wires, screws, a plate or gas pockets near; lower "
+                            "the bone threshold or drop the objects",
                             options.boneThreshold_hu));
   }
   const Eigen::Vector3d centroid_mm = ct.lpsFromIjk(sum_ijk / boneCount);
@@ -161,6 +162,7 @@ Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const
     shaft.kind = "screw_shaft";
     shaft.shape = ForeignObject::Shape::Cylinder;
     shaft.material = Material::Titanium;
+    shaft.density_g_per_cm3 = MassAttenuationTable::density_g_per_cm3(Material::Titanium);
     shaft.a_mm = p;
     shaft.b_mm = p + 40.0 * dir;
     shaft.radius_mm = 2.25;
@@ -188,6 +190,39 @@ Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const
     plate.halfExtent_mm = Eigen::Vector3d(50.0, 6.0, 1.75);
     plate.a_mm = p + normal * 2.0;
     set.m_objects.push_back(plate);
+  }
+  // Gas pockets: random spheres whose centre and 26 surface points all lie in soft tissue.
+  const auto isSoftTissue = [&](const Eigen::Vector3d& p_mm) {
+    const Eigen::Vector3i ijk = ct.ijkFromLps(p_mm).array().round().cast<int>();
+    if ((ijk.array() < 0).any() || (ijk.array() >= dims.array()).any()) return false;
+    const float hu = ct.at(ijk.x(), ijk.y(), ijk.z());
+    return hu > -200.0f && hu < 300.0f;
+  };
+  for (int n = 0; n < options.gasPocketCount; ++n) {
+    bool placed = false;
+    for (int attempt = 0; attempt < 500 && !placed; ++attempt) {
+      const Eigen::Vector3d centre = centroid_mm + randomUnit(random) * random.uniform(0.0, 100.0);
+      const double radius = random.uniform(8.0, 20.0);
+      placed = isSoftTissue(centre);
+      for (int a = -1; a <= 1 && placed; ++a) {
+        for (int b = -1; b <= 1 && placed; ++b) {
+          for (int c = -1; c <= 1 && placed; ++c) {
+            if (a != 0 || b != 0 || c != 0) placed = isSoftTissue(centre + radius * Eigen::Vector3d(a, b, c).normalized());
+          }
+        }
+      }
+      if (placed) {
+        ForeignObject pocket;
+        pocket.kind = "gas_pocket";
+        pocket.shape = ForeignObject::Shape::Sphere;
+        pocket.material = Material::SoftTissue;
+        pocket.density_g_per_cm3 = -1.0;
+        pocket.a_mm = centre;
+        pocket.radius_mm = radius;
+        set.m_objects.push_back(pocket);
+      }
+    }
+    if (!placed) return fail("found no soft tissue near the bone for a gas pocket; drop --gas-pockets for this CT");
   }
   return set;
 }
@@ -243,8 +278,7 @@ void ForeignObjectSet::accumulate(const Eigen::Vector3d& origin_mm, const Eigen:
       case ForeignObject::Shape::Box: chord_mm = boxChord(object, origin_mm, direction); break;
     }
     if (chord_mm > 0.0) {
-      paths[static_cast<int>(object.material)] +=
-          MassAttenuationTable::density_g_per_cm3(object.material) * chord_mm * 0.1;
+      paths[static_cast<int>(object.material)] += object.density_g_per_cm3 * chord_mm * 0.1;
     }
   }
 }
@@ -255,6 +289,7 @@ nlohmann::ordered_json ForeignObjectSet::toJson() const {
     nlohmann::ordered_json entry;
     entry["kind"] = object.kind;
     entry["material"] = std::string(MassAttenuationTable::name(object.material));
+    entry["density_g_per_cm3"] = object.density_g_per_cm3;
     switch (object.shape) {
       case ForeignObject::Shape::Sphere:
         entry["centre_mm"] = JsonDocument::array(object.a_mm);

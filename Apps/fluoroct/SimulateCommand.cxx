@@ -31,7 +31,7 @@ constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", 
                                          "--offset",      "--gamma",            "--pincushion", "--s-distortion-deg",
                                          "--vignetting",  "--collimator",       "--kwires",     "--screws",
                                          "--plate",       "--spheres",          "--sphere-pitch-mm",
-                                         "--fixed-exposure"};
+                                         "--fixed-exposure", "--gas-pockets"};
 /// Options that only the DRR model reads.
 constexpr const char* kDrrOnly[] = {"--method", "--i0"};
 
@@ -109,6 +109,9 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--screws", p.screwCount, "physical: number of titanium screws into the bone")
       ->capture_default_str();
   command->add_flag("--plate", p.plate, "physical: a steel bone plate on the bone surface");
+  command->add_option("--gas-pockets", p.gasPocketCount,
+                      "physical: soft-tissue change, number of bowel-gas pockets near the bone (not in the CT)")
+      ->capture_default_str();
   command->add_flag("--spheres", p.calibrationSpheres,
                     "physical: a calibration grid of steel spheres near the detector, listed in views.json");
   command->add_option("--sphere-pitch-mm", p.sphereSpacing_mm, "physical: calibration grid pitch in mm")

@@ -138,7 +138,8 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
   const auto out = dir / "physical";
   const auto run = fct::test::runCli(fmt::format(
       "simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --model physical --kvp 75 --dose 2000 --psf-px 0.8 "
-      "--pincushion 0.03 --vignetting 0.2 --collimator 1.1 --kwires 1 --screws 1 --plate --spheres --sphere-pitch-mm 50 "
+      "--pincushion 0.03 --vignetting 0.2 --collimator 1.1 --kwires 1 --screws 1 --plate --gas-pockets 1 --spheres "
+      "--sphere-pitch-mm 50 "
       "--ct-slice-mm 8",
       (dir / "ct.nrrd").string(), (dir / "views.json").string(), (dir / "pose.json").string(), out.string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
@@ -164,6 +165,7 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
   EXPECT_NE(text.find("\"tube_voltage_kvp\": 75"), std::string::npos) << text;
   EXPECT_NE(text.find("\"slice_spacing_mm\": 8"), std::string::npos) << text;
   EXPECT_NE(text.find("\"kind\": \"plate\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"kind\": \"gas_pocket\""), std::string::npos) << text;
 }
 
 TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {

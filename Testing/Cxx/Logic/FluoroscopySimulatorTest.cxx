@@ -167,6 +167,25 @@ TEST(FluoroscopySimulator, MetalObjectDarkensItsPixels) {
   EXPECT_EQ(brighter, 0);
 }
 
+TEST(FluoroscopySimulator, GasPocketBrightensItsPixels) {
+  const fct::Volume ct = smallPhantom();
+  const fct::Camera camera = fct::Camera::lookingAt(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 800.0,
+                                                    1000.0, 96, 72, 2.5);
+  fct::FluoroscopyOptions options = absolute();
+  auto plain = fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), options, 1);
+  options.gasPocketCount = 2;
+  auto withGas = fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), options, 1);
+  ASSERT_TRUE(plain.ok() && withGas.ok()) << plain.error() << withGas.error();
+  int brighter = 0, darker = 0;
+  for (std::size_t i = 0; i < plain.value().pixels.size(); ++i) {
+    const double ratio = withGas.value().pixels[i] / plain.value().pixels[i];
+    if (ratio > 1.2) ++brighter;
+    if (ratio < 1.0 - 1e-6) ++darker;
+  }
+  EXPECT_GT(brighter, 10);
+  EXPECT_EQ(darker, 0);
+}
+
 TEST(FluoroscopySimulator, CollimatorZeroesOutsideItsCircle) {
   fct::FluoroscopyOptions options = absolute();
   options.collimatorRadiusFraction = 0.8;

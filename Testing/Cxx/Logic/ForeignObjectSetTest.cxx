@@ -62,6 +62,20 @@ TEST(ForeignObjectSet, PlacesImplantsOnTheBoneDeterministically) {
   placed.value().accumulate(wire.a_mm - 5.0 * (wire.b_mm - wire.a_mm).normalized(), (wire.b_mm - wire.a_mm).normalized(), paths);
   EXPECT_GE(paths[kIron], kIronDensity * 15.0 - 1e-9);
   EXPECT_EQ(placed.value().toJson().size(), 5u);
+
+  // Gas pockets lie in soft tissue and remove tissue mass along their chords.
+  fct::ImplantOptions gas;
+  gas.gasPocketCount = 2;
+  auto pockets = fct::ForeignObjectSet::placeNearBone(ct, gas);
+  ASSERT_TRUE(pockets.ok()) << pockets.error();
+  ASSERT_EQ(pockets.value().objects().size(), 2u);
+  const fct::ForeignObject& pocket = pockets.value().objects()[0];
+  EXPECT_EQ(pocket.kind, "gas_pocket");
+  const Eigen::Vector3i centre = ct.ijkFromLps(pocket.a_mm).array().round().cast<int>();
+  EXPECT_LT(ct.at(centre.x(), centre.y(), centre.z()), 300.0f);
+  fct::MassPaths through{};
+  pockets.value().accumulate(pocket.a_mm - Eigen::Vector3d(0, 0, 100), Eigen::Vector3d::UnitZ(), through);
+  EXPECT_LE(through[static_cast<int>(fct::Material::SoftTissue)], -0.2 * pocket.radius_mm + 1e-9);
 }
 
 TEST(ForeignObjectSet, RejectsNoBoneAndBadSizes) {
@@ -74,6 +88,9 @@ TEST(ForeignObjectSet, RejectsNoBoneAndBadSizes) {
   EXPECT_FALSE(fct::ForeignObjectSet::placeNearBone(water, options).ok());
   options.kwireCount = -1;
   EXPECT_FALSE(fct::ForeignObjectSet::placeNearBone(water, options).ok());
+  options.kwireCount = 0;
+  options.gasPocketCount = 21;
+  EXPECT_FALSE(fct::ForeignObjectSet::placeNearBone(phantom(), options).ok());
   EXPECT_TRUE(fct::ForeignObjectSet::placeNearBone(water, {}).ok());  // nothing asked, nothing needed
   const fct::Camera camera =
       fct::Camera::lookingAt(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 800.0, 1000.0, 100, 100, 1.0);
