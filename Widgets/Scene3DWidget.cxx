@@ -1,5 +1,6 @@
 #include "Scene3DWidget.h"
 
+#include <QGuiApplication>
 #include <QMouseEvent>
 #include <QOpenGLContext>
 #include <QOpenGLExtraFunctions>
@@ -113,18 +114,7 @@ vtkSmartPointer<vtkActor> actorOf(vtkPolyData* polyData) {
 }  // namespace
 
 Scene3DWidget::Scene3DWidget(StudioDocument* document, QWidget* parent) : QOpenGLWidget(parent), m_document(document) {
-  // VTK's OpenGL2 backend needs an OpenGL 3.2 core profile context.
-  QSurfaceFormat format;
-  format.setRenderableType(QSurfaceFormat::OpenGL);
-  format.setVersion(3, 2);
-  format.setProfile(QSurfaceFormat::CoreProfile);
-  format.setRedBufferSize(8);
-  format.setGreenBufferSize(8);
-  format.setBlueBufferSize(8);
-  format.setAlphaBufferSize(8);
-  format.setDepthBufferSize(8);
-  format.setStencilBufferSize(0);
-  setFormat(format);
+  setFormat(surfaceFormat());
   m_window->AddRenderer(m_renderer);
   m_window->SetReadyForRendering(false);
   m_window->SetFrameBlitModeToNoBlit();  // paintGL copies the image into the widget's framebuffer
@@ -186,6 +176,28 @@ Scene3DWidget::Scene3DWidget(StudioDocument* document, QWidget* parent) : QOpenG
   });
   rebuildBone();
   rebuildViews();
+}
+
+QSurfaceFormat Scene3DWidget::surfaceFormat() {
+  QSurfaceFormat format;
+  format.setRenderableType(QSurfaceFormat::OpenGL);
+  format.setVersion(3, 2);
+  format.setProfile(QSurfaceFormat::CoreProfile);
+  format.setRedBufferSize(8);
+  format.setGreenBufferSize(8);
+  format.setBlueBufferSize(8);
+  format.setAlphaBufferSize(8);
+  format.setDepthBufferSize(8);
+  format.setStencilBufferSize(0);
+  return format;
+}
+
+bool Scene3DWidget::openGlAvailable() {
+  // Qt's offscreen platform may create contexts (with an X display around) but cannot show OpenGL widgets.
+  if (QGuiApplication::platformName() == QStringLiteral("offscreen")) return false;
+  QOpenGLContext probe;
+  probe.setFormat(surfaceFormat());
+  return probe.create() && probe.format().majorVersion() * 10 + probe.format().minorVersion() >= 32;
 }
 
 Scene3DWidget::~Scene3DWidget() {

@@ -6,6 +6,7 @@
 // plane with the X-ray image textured in place. Mouse: left drag rotates, middle drag pans, wheel zooms.
 
 #include <QOpenGLWidget>
+#include <QSurfaceFormat>
 #include <QString>
 
 #include <Eigen/Geometry>
@@ -33,6 +34,12 @@ class Scene3DWidget : public QOpenGLWidget {
   /// A 3D view of `document`, updated on its changes.
   explicit Scene3DWidget(StudioDocument* document, QWidget* parent = nullptr);
   ~Scene3DWidget() override;
+
+  /// True when this platform can create the OpenGL 3.2 core context the view needs (false e.g. on Qt's offscreen
+  /// platform, where a QOpenGLWidget must not even be shown).
+  static bool openGlAvailable();
+  /// The surface format the view asks for (OpenGL 3.2 core profile, as VTK's OpenGL2 backend needs).
+  static QSurfaceFormat surfaceFormat();
 
   /// Bone threshold of the surface, HU (default 250).
   void setBoneThreshold_hu(double threshold_hu);

@@ -88,8 +88,16 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
                            .arg(value, 0, 'f', 0));
     });
   }
-  m_scene = new Scene3DWidget(m_document, lowerRow);
-  lowerRow->addWidget(m_scene);
+  if (Scene3DWidget::openGlAvailable()) {
+    m_scene = new Scene3DWidget(m_document, lowerRow);
+    lowerRow->addWidget(m_scene);
+  } else {
+    auto* no3d = new QLabel(tr("3D view: no OpenGL 3.2 on this display"), lowerRow);
+    no3d->setAlignment(Qt::AlignCenter);
+    no3d->setWordWrap(true);
+    no3d->setStyleSheet(QStringLiteral("background: #1a1c24; color: #969696;"));
+    lowerRow->addWidget(no3d);
+  }
   rows->addWidget(m_xrayRow);
   rows->addWidget(lowerRow);
   rows->setSizes({460, 420});
@@ -206,8 +214,10 @@ void StudioMainWindow::buildMenus() {
   view->addAction(tr("&Reset views"), this, [this] {
     for (SliceViewWidget* slice : m_sliceViews) slice->resetView();
     for (XrayViewWidget* xray : m_xrayViews) xray->resetView();
-    m_scene->resetCamera();
-    m_scene->update();
+    if (m_scene) {
+      m_scene->resetCamera();
+      m_scene->update();
+    }
   });
 
   QMenu* help = menuBar()->addMenu(tr("&Help"));

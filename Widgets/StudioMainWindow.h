@@ -69,7 +69,7 @@ class StudioMainWindow : public QMainWindow {
   const std::vector<XrayViewWidget*>& xrayViews() const { return m_xrayViews; }
   /// The slice views: axial, coronal, sagittal.
   const std::array<SliceViewWidget*, 3>& sliceViews() const { return m_sliceViews; }
-  /// The 3D view.
+  /// The 3D view (null when the display has no OpenGL 3.2, e.g. Qt's offscreen platform).
   Scene3DWidget* sceneView() const { return m_scene; }
   /// The autosave of the document.
   SessionAutosave* autosave() const { return m_autosave; }

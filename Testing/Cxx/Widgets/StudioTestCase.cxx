@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "TestSupport.h"
 
@@ -9,10 +10,10 @@ namespace fct::test {
 
 namespace {
 
-std::filesystem::path buildCase() {
-  const auto dir = std::filesystem::temp_directory_path() / "fluoroct_tests" / "studio_case";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+namespace fs = std::filesystem;
+
+/// Makes the case in `dir` with the CLI; false (with a test failure) if a command fails.
+bool makeCase(const fs::path& dir) {
   const std::string d = dir.string();
   const std::string commands[] = {
       fmt::format("phantom --out '{}/ct.nrrd' --dims 96 96 72 --spacing-mm 1.6", d),
@@ -29,10 +30,27 @@ std::filesystem::path buildCase() {
     const ProcessResult r = runCli(command);
     if (r.exitCode != 0) {
       ADD_FAILURE() << "fluoroct " << command << " failed: " << r.err;
-      return {};
+      return false;
     }
   }
-  return dir;
+  return true;
+}
+
+/// The case is shared by every test process of a run (CTest runs each test in its own process, in parallel): it is
+/// made in a private folder and renamed into place, named after the CLI's build time so a rebuilt CLI remakes it.
+fs::path buildCase() {
+  std::error_code ec;
+  const auto stamp = fs::last_write_time(cliPath(), ec).time_since_epoch().count();
+  const fs::path root = fs::temp_directory_path() / "fluoroct_tests";
+  const fs::path dir = root / fmt::format("studio_case_{}", stamp);
+  if (fs::exists(dir / "initial_pose.json", ec)) return dir;
+  const fs::path scratch = root / fmt::format("studio_case_{}.{}", stamp, ::getpid());
+  fs::remove_all(scratch, ec);
+  fs::create_directories(scratch);
+  if (!makeCase(scratch)) return {};
+  fs::rename(scratch, dir, ec);  // fails when another process was first: use its case
+  fs::remove_all(scratch, ec);
+  return fs::exists(dir / "initial_pose.json", ec) ? dir : fs::path();
 }
 
 }  // namespace
