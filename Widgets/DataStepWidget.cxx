@@ -71,8 +71,7 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   seriesLayout->addWidget(m_loadSeries);
   m_seriesRow->hide();
   ctLayout->addWidget(m_seriesRow);
-  m_ctSummary = new QLabel(ctBox);
-  m_ctSummary->setWordWrap(true);
+  m_ctSummary = new QLabel(ctBox);  // not word-wrapped: wrapped labels get clipped in the step's scroll area
   m_ctSummary->setTextInteractionFlags(Qt::TextSelectableByMouse);
   ctLayout->addWidget(m_ctSummary);
   layout->addWidget(ctBox);
@@ -97,7 +96,6 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   m_viewTable->setMaximumHeight(150);
   viewLayout->addWidget(m_viewTable);
   m_viewSummary = new QLabel(viewBox);
-  m_viewSummary->setWordWrap(true);
   viewLayout->addWidget(m_viewSummary);
   layout->addWidget(viewBox);
 
@@ -362,7 +360,7 @@ void DataStepWidget::refreshSummary() {
   if (const auto& ct = m_document->ct()) {
     const auto [low, high] = ct->valueRange();
     const Eigen::Vector3d size_mm = ct->spacing_mm().cwiseProduct(ct->dims().cast<double>());
-    m_ctSummary->setText(tr("<b>%1</b><br>%2 × %3 × %4 voxels of %5 × %6 × %7 mm (%8 × %9 × %10 mm), values %11 to "
+    m_ctSummary->setText(tr("<b>%1</b><br>%2 × %3 × %4 voxels of %5 × %6 × %7 mm<br>(%8 × %9 × %10 mm), values %11 to "
                             "%12 HU<br><small>%13</small>")
                              .arg(qs(m_document->ctPath().filename()).toHtmlEscaped())
                              .arg(ct->dims().x())
@@ -376,7 +374,8 @@ void DataStepWidget::refreshSummary() {
                              .arg(size_mm.z(), 0, 'f', 0)
                              .arg(low, 0, 'f', 0)
                              .arg(high, 0, 'f', 0)
-                             .arg(qs(ct->description).toHtmlEscaped()));
+                             .arg(qs(ct->description).left(60).toHtmlEscaped()));
+    m_ctSummary->setToolTip(qs(ct->description));
   } else {
     m_ctSummary->setText(tr("No CT loaded. Open a DICOM folder or a volume file."));
   }
@@ -401,7 +400,7 @@ void DataStepWidget::refreshSummary() {
                    ? tr("%1 view(s) from X-ray files").arg(views.size())
                    : tr("%1 view(s) from %2").arg(views.size()).arg(qs(m_document->viewFilePath().filename()));
     if (m_document->truthPose()) {
-      viewText += tr("<br>Ground truth pose known (simulated case): the Review step shows the error against it.");
+      viewText += tr("<br>Ground truth pose known (simulated case):<br>the Review step shows the error against it.");
     }
   }
   m_viewSummary->setText(viewText);

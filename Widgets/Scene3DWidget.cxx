@@ -45,6 +45,7 @@ namespace fct {
 namespace {
 
 constexpr int kMaxGridSide = 128;  ///< the bone surface is extracted on a block-averaged grid at most this large
+constexpr std::size_t kActorsPerView = 3;  ///< detector, source, beam (in this order)
 
 vtkSmartPointer<vtkMatrix4x4> vtkMatrix(const Eigen::Matrix4d& m) {
   auto matrix = vtkSmartPointer<vtkMatrix4x4>::New();
@@ -330,7 +331,22 @@ void Scene3DWidget::resetCamera() {
   camera->SetFocalPoint(0.0, 0.0, 0.0);
   camera->SetPosition(0.45, -1.0, 0.35);  // from the patient's front-left (LPS: -y anterior, +x left), a bit above
   camera->SetViewUp(0.0, 0.0, 1.0);       // superior up
-  m_renderer->ResetCamera();
+  // Fit the bone and the detectors; the sources (a metre away) would make the bone a speck.
+  double bounds[6] = {1e300, -1e300, 1e300, -1e300, 1e300, -1e300};
+  const auto include = [&bounds](vtkActor* actor) {
+    const double* b = actor->GetBounds();
+    for (int a = 0; a < 3; ++a) {
+      bounds[2 * a] = std::min(bounds[2 * a], b[2 * a]);
+      bounds[2 * a + 1] = std::max(bounds[2 * a + 1], b[2 * a + 1]);
+    }
+  };
+  if (m_bone) include(m_bone);
+  for (std::size_t i = 0; i < m_viewActors.size(); i += kActorsPerView) include(m_viewActors[i]);  // detectors
+  if (bounds[0] <= bounds[1]) {
+    m_renderer->ResetCamera(bounds);
+  } else {
+    m_renderer->ResetCamera();
+  }
   m_cameraPlaced = true;
 }
 
