@@ -96,3 +96,41 @@ TEST(DataStepWidget, CaseFolderWithoutCtNamesWhatIsMissing) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(DataStepWidget, OpensARealDicomFolderThroughTheSeriesChooser) {
+  FCT_REQUIRE_DATA("ct/head_ge_irregular");
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCt(QString::fromStdString((fct::test::dataDir() / "ct/head_ge_irregular").string()));
+  auto [ok, message] = waitForLoad(finished);
+  ASSERT_TRUE(ok) << message.toStdString();
+  if (step.seriesChoiceCount() > 1) {  // several series: the chooser is shown, nothing loaded yet
+    EXPECT_FALSE(document.ct());
+    step.chooseSeries(0);
+    step.loadChosenSeries();
+    std::tie(ok, message) = waitForLoad(finished);
+    ASSERT_TRUE(ok) << message.toStdString();
+  }
+  ASSERT_TRUE(document.ct());
+  EXPECT_GT(document.ct()->voxelCount(), 0u);
+  // An irregular series is resampled with a warning, which the step shows in words.
+  EXPECT_FALSE(document.ctWarnings().empty());
+  EXPECT_TRUE(step.summaryText().contains(QStringLiteral("CT warnings"))) << step.summaryText().toStdString();
+}
+
+TEST(DataStepWidget, OpensThePelvisVolumeFile) {
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCt(QString::fromStdString((fct::test::dataDir() / "ct/pelvis_totalseg.nii.gz").string()));
+  const auto [ok, message] = waitForLoad(finished);
+  ASSERT_TRUE(ok) << message.toStdString();
+  ASSERT_TRUE(document.ct());
+  EXPECT_TRUE(step.summaryText().contains(QStringLiteral("pelvis_totalseg.nii.gz")));
+}
+
+}  // namespace
