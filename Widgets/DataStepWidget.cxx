@@ -377,7 +377,7 @@ void DataStepWidget::refreshSummary() {
                              .arg(qs(ct->description).left(60).toHtmlEscaped()));
     m_ctSummary->setToolTip(qs(ct->description));
   } else {
-    m_ctSummary->setText(tr("No CT loaded. Open a DICOM folder or a volume file."));
+    m_ctSummary->setText(tr("No CT loaded.<br>Open a DICOM folder or a volume file."));
   }
 
   const auto& views = m_document->views();
@@ -394,7 +394,7 @@ void DataStepWidget::refreshSummary() {
   }
   QString viewText;
   if (views.empty()) {
-    viewText = tr("No X-ray views loaded. Open a view file (or X-ray DICOMs with C-arm geometry).");
+    viewText = tr("No X-ray views loaded. Open a view file<br>(or X-ray DICOMs with C-arm geometry).");
   } else {
     viewText = m_document->viewFilePath().empty()
                    ? tr("%1 view(s) from X-ray files").arg(views.size())

@@ -73,14 +73,14 @@ int main(int argc, char** argv) {
   }
   window.show();
 
+  // Unsaved changes of a run that crashed are offered back first, before anything else can overwrite them.
+  if (!parser.isSet(screenshot)) window.offerAutosave();
   bool loading = false;
   if (!positional.isEmpty()) {
     window.openSession(positional.front());
   } else if (parser.isSet(caseFolder)) {
     loading = true;
     window.dataStep()->openCaseFolder(parser.value(caseFolder));
-  } else if (!parser.isSet(screenshot)) {
-    QTimer::singleShot(0, &window, [&window] { window.offerAutosave(); });
   }
 
   if (parser.isSet(screenshot)) {
