@@ -142,6 +142,7 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
       showError(message);
     }
   });
+  // The workflow steps, in order: one line each.
   addStep(tr("Data"), m_dataStep);
 
   buildMenus();
