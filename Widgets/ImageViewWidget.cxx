@@ -323,11 +323,6 @@ void ImageViewWidget::paintEvent(QPaintEvent*) {
                                                  .arg(m_zoom, 0, 'f', 2));
 }
 
-void ImageViewWidget::resizeEvent(QResizeEvent* event) {
-  QWidget::resizeEvent(event);
-  update();
-}
-
 void ImageViewWidget::wheelEvent(QWheelEvent* event) {
   zoomAbout(event->position(), event->angleDelta().y() / 120.0);
   event->accept();

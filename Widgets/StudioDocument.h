@@ -181,16 +181,25 @@ class StudioDocument : public QObject {
   void clear();
 
  signals:
+  /// The CT was replaced or cleared.
   void ctChanged();
+  /// The views (X-rays and cameras) were replaced or added to.
   void viewsChanged();
+  /// The landmarks were replaced.
   void landmarksChanged();
+  /// The initial pose was set or cleared.
   void initialPoseChanged();
+  /// The ROI parameters changed.
   void roiParametersChanged();
+  /// The registration options changed.
   void registrationOptionsChanged();
+  /// The result or its verdict changed.
   void resultChanged();
+  /// The ground truth was set or cleared.
   void truthPoseChanged();
   /// Emitted after any change of the content (for autosave and the title bar).
   void changed();
+  /// The document became modified (true) or saved (false).
   void modifiedChanged(bool modified);
 
  private:
