@@ -2,8 +2,16 @@
 # Builds FluoroCT (installing any missing Debian packages) and runs the richest end-to-end job on the built-in
 # phantom case, which needs no data: phantom CT -> standard C-arm views -> simulated X-rays at a known pose ->
 # a start pose 10 mm away -> registration (fast preset) with the pose error, time and contour overlays -> DRRs.
+#
+# scripts/demo.sh --gui instead makes the built-in case for FluoroCT Studio (scripts/studio_case.sh) and opens it.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+if [[ "${1:-}" == "--gui" ]]; then
+  CASE="${FCT_DEMO_DIR:-$FCT_BUILD/studio-case}"
+  rm -rf "$CASE"
+  "$FCT_ROOT/scripts/studio_case.sh" "$CASE"
+  exec "$FCT_BUILD/bin/fluoroct-studio" --case "$CASE"
+fi
 BIN="$FCT_BUILD/bin"
 OUT="${FCT_DEMO_DIR:-$FCT_BUILD/demo}"
 rm -rf "$OUT"

@@ -1,0 +1,136 @@
+#include <gtest/gtest.h>
+
+#include <QSignalSpy>
+#include <QTest>
+
+#include <fstream>
+
+#include "DataStepWidget.h"
+#include "StudioDocument.h"
+#include "StudioTestCase.h"
+#include "TestSupport.h"
+
+namespace {
+
+using fct::DataStepWidget;
+using fct::StudioDocument;
+
+/// Waits for the step's background load and returns (ok, message).
+std::pair<bool, QString> waitForLoad(QSignalSpy& spy) {
+  if (spy.isEmpty() && !spy.wait(20000)) return {false, QStringLiteral("timed out")};
+  const QList<QVariant> args = spy.takeFirst();
+  return {args.at(0).toBool(), args.at(1).toString()};
+}
+
+TEST(DataStepWidget, LoadsTheBuiltinCaseFolderAndDescribesIt) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCaseFolder(QString::fromStdString(dir.string()));
+  const auto [ok, message] = waitForLoad(finished);
+  ASSERT_TRUE(ok) << message.toStdString();
+  EXPECT_FALSE(step.isBusy());
+  ASSERT_TRUE(document.ct());
+  EXPECT_EQ(document.views().size(), 2u);
+  EXPECT_TRUE(document.initialPose().has_value());
+  EXPECT_TRUE(document.truthPose().has_value());
+  const QString summary = step.summaryText();
+  EXPECT_TRUE(summary.contains(QStringLiteral("96 × 96 × 72 voxels"))) << summary.toStdString();
+  EXPECT_TRUE(summary.contains(QStringLiteral("Ground truth"))) << summary.toStdString();
+  EXPECT_TRUE(step.errorText().isEmpty());
+}
+
+TEST(DataStepWidget, NonDicomFolderShowsAMessageAndKeepsTheCt) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  StudioDocument document;
+  ASSERT_TRUE(document.loadCt(dir / "ct.nrrd").ok());
+  const auto ct = document.ct();
+  const auto folder = fct::test::scratchDir();
+  std::ofstream(folder / "notes.txt") << "not a DICOM file";
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCt(QString::fromStdString(folder.string()));
+  const auto [ok, message] = waitForLoad(finished);
+  EXPECT_FALSE(ok);
+  EXPECT_TRUE(message.contains(QStringLiteral("Could not open the DICOM folder"))) << message.toStdString();
+  EXPECT_EQ(step.errorText(), message);
+  EXPECT_EQ(document.ct(), ct);
+  EXPECT_EQ(step.seriesChoiceCount(), 0);
+}
+
+TEST(DataStepWidget, ViewFileWithErrorsShowsTheKeyAndKeepsTheViews) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  StudioDocument document;
+  ASSERT_TRUE(document.loadViews(dir / "views.json").ok());
+  const auto bad = fct::test::scratchDir() / "views.json";
+  std::ofstream(bad) << R"({"views": [{"name": "ap", "image": {"path": ")" << (dir / "ap.png").string() << R"("},
+    "detector": {"cols": 192, "rows": 144, "pixel_spacing_mm": [1.6, 1.6]},
+    "source_to_detector_mm": -5, "principal_point_px": [95.5, 71.5],
+    "T_world_from_camera": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openViewFile(QString::fromStdString(bad.string()));
+  const auto [ok, message] = waitForLoad(finished);
+  EXPECT_FALSE(ok);
+  EXPECT_TRUE(message.contains(QStringLiteral("source_to_detector_mm"))) << message.toStdString();
+  EXPECT_EQ(document.views().size(), 2u);
+  EXPECT_EQ(document.viewFilePath(), dir / "views.json");
+}
+
+TEST(DataStepWidget, CaseFolderWithoutCtNamesWhatIsMissing) {
+  const auto folder = fct::test::scratchDir();
+  auto files = DataStepWidget::findCaseFiles(folder);
+  ASSERT_FALSE(files.ok());
+  EXPECT_NE(files.error().find("ct.nrrd"), std::string::npos) << files.error();
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCaseFolder(QString::fromStdString(folder.string()));
+  ASSERT_EQ(finished.count(), 1);  // refused at once, nothing started
+  EXPECT_FALSE(finished.at(0).at(0).toBool());
+  EXPECT_FALSE(document.isModified());
+}
+
+}  // namespace
+
+namespace {
+
+TEST(DataStepWidget, OpensARealDicomFolderThroughTheSeriesChooser) {
+  FCT_REQUIRE_DATA("ct/head_ge_irregular");
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCt(QString::fromStdString((fct::test::dataDir() / "ct/head_ge_irregular").string()));
+  auto [ok, message] = waitForLoad(finished);
+  ASSERT_TRUE(ok) << message.toStdString();
+  if (step.seriesChoiceCount() > 1) {  // several series: the chooser is shown, nothing loaded yet
+    EXPECT_FALSE(document.ct());
+    step.chooseSeries(0);
+    step.loadChosenSeries();
+    std::tie(ok, message) = waitForLoad(finished);
+    ASSERT_TRUE(ok) << message.toStdString();
+  }
+  ASSERT_TRUE(document.ct());
+  EXPECT_GT(document.ct()->voxelCount(), 0u);
+  // An irregular series is resampled with a warning, which the step shows in words.
+  EXPECT_FALSE(document.ctWarnings().empty());
+  EXPECT_TRUE(step.summaryText().contains(QStringLiteral("CT warnings"))) << step.summaryText().toStdString();
+}
+
+TEST(DataStepWidget, OpensThePelvisVolumeFile) {
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.openCt(QString::fromStdString((fct::test::dataDir() / "ct/pelvis_totalseg.nii.gz").string()));
+  const auto [ok, message] = waitForLoad(finished);
+  ASSERT_TRUE(ok) << message.toStdString();
+  ASSERT_TRUE(document.ct());
+  EXPECT_TRUE(step.summaryText().contains(QStringLiteral("pelvis_totalseg.nii.gz")));
+}
+
+}  // namespace

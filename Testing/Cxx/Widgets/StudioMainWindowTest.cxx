@@ -1,0 +1,198 @@
+#include <gtest/gtest.h>
+
+#include <QAbstractButton>
+#include <QApplication>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QSignalSpy>
+#include <QStandardPaths>
+#include <QStatusBar>
+#include <QTest>
+#include <QTimer>
+
+#include <fstream>
+
+#include "DataStepWidget.h"
+#include "SessionAutosave.h"
+#include "SliceViewWidget.h"
+#include "StudioDocument.h"
+#include "StudioMainWindow.h"
+#include "StudioTestCase.h"
+#include "TestSupport.h"
+#include "XrayViewWidget.h"
+
+namespace {
+
+using fct::StudioMainWindow;
+
+/// Opens the built-in case through the Data step and waits for it.
+void openBuiltinCase(StudioMainWindow& window) {
+  QSignalSpy finished(window.dataStep(), &fct::DataStepWidget::loadFinished);
+  window.dataStep()->openCaseFolder(QString::fromStdString(fct::test::builtinCaseDir().string()));
+  ASSERT_TRUE(finished.wait(20000));
+  ASSERT_TRUE(finished.at(0).at(0).toBool()) << finished.at(0).at(1).toString().toStdString();
+}
+
+/// Answers the next modal message box with `button` (from the event loop, while it is open).
+void answerNextMessageBox(QMessageBox::StandardButton button, QString* text = nullptr) {
+  QTimer::singleShot(0, [button, text] {
+    auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+    if (!box) return;
+    if (text) *text = box->text();
+    box->button(button)->click();
+  });
+}
+
+/// A step with the hooks the main window calls.
+class CountingStep : public QWidget {
+ public:
+  void setActive(bool active) { active ? ++activations : ++deactivations; }
+  void attachViews(const std::vector<fct::XrayViewWidget*>& xrays, const std::array<fct::SliceViewWidget*, 3>& slices) {
+    lastXrayCount = static_cast<int>(xrays.size());
+    slicesAttached = slices[0] != nullptr;
+    ++attachments;
+  }
+  int activations = 0, deactivations = 0, attachments = 0, lastXrayCount = -1;
+  bool slicesAttached = false;
+};
+
+class StudioMainWindowTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    QStandardPaths::setTestModeEnabled(true);  // recent sessions go to a test settings file
+    ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+    m_folder = fct::test::scratchDir();
+  }
+  std::filesystem::path m_folder;
+};
+
+TEST_F(StudioMainWindowTest, ShowsTitleMenusDataStepAndReadyStatus) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  EXPECT_TRUE(window.windowTitle().contains(QStringLiteral("FluoroCT Studio")));
+  EXPECT_FALSE(window.menuBar()->actions().isEmpty());
+  EXPECT_EQ(window.statusBar()->currentMessage(), QStringLiteral("Ready"));
+  ASSERT_EQ(window.stepCount(), 1);
+  EXPECT_EQ(window.stepTitle(0), QStringLiteral("Data"));
+  EXPECT_TRUE(window.xrayViews().empty());
+}
+
+TEST_F(StudioMainWindowTest, StepsAddedByOneLineGetTheViewsAndActivation) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  auto* step = window.addStep(QStringLiteral("Initial pose"), new CountingStep);
+  EXPECT_EQ(window.stepCount(), 2);
+  EXPECT_EQ(step->attachments, 1);
+  EXPECT_TRUE(step->slicesAttached);
+  EXPECT_TRUE(window.showStepNamed(QStringLiteral("initial-pose")));
+  EXPECT_EQ(window.currentStep(), 1);
+  EXPECT_EQ(step->activations, 1);
+  window.showStep(0);
+  EXPECT_EQ(step->deactivations, 1);
+  EXPECT_FALSE(window.showStepNamed(QStringLiteral("nope")));
+  openBuiltinCase(window);
+  EXPECT_EQ(step->lastXrayCount, 2);
+}
+
+TEST_F(StudioMainWindowTest, LoadsTheCaseIntoTheViewsAndLinksTheCrosshair) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  ASSERT_EQ(window.xrayViews().size(), 2u);
+  EXPECT_EQ(window.xrayViews()[1]->title(), QStringLiteral("lateral"));
+  EXPECT_EQ(window.xrayViews()[0]->imageSize(), QSize(192, 144));
+  for (fct::SliceViewWidget* slice : window.sliceViews()) EXPECT_TRUE(slice->hasImage());
+
+  fct::SliceViewWidget* axial = window.sliceViews()[0];
+  const Eigen::Vector3d target(12.0, -20.0, axial->slicePosition_mm());
+  QTest::mouseClick(axial, Qt::LeftButton, Qt::NoModifier, axial->widgetPointForCtPoint(target));
+  const Eigen::Vector3d coronal = window.sliceViews()[1]->crosshair_ct_mm();
+  EXPECT_LT((coronal - target).norm(), 1.0) << coronal.transpose();
+  EXPECT_NEAR(window.sliceViews()[2]->slicePosition_mm(), -coronal.x(), 1e-9);  // sagittal normal = -x (R)
+  EXPECT_TRUE(window.isWindowModified());
+}
+
+TEST_F(StudioMainWindowTest, AutosaveAppearsAfterAChangeAndIsRestoredAfterACrash) {
+  const auto autosave = m_folder / "autosave.json";
+  {
+    StudioMainWindow crashed(autosave);
+    openBuiltinCase(crashed);
+    EXPECT_TRUE(std::filesystem::exists(autosave));
+    crashed.document()->setRegistrationOptions({"paper", 99, "siddon"});
+    // Destroyed without closing, as after a crash: the side file stays.
+  }
+  ASSERT_TRUE(std::filesystem::exists(autosave));
+  StudioMainWindow next(autosave);
+  EXPECT_TRUE(next.autosave()->exists());
+  ASSERT_TRUE(next.restoreAutosave()) << next.lastMessage().toStdString();
+  EXPECT_EQ(next.document()->views().size(), 2u);
+  EXPECT_EQ(next.document()->registrationOptions().seed, 99u);
+  EXPECT_TRUE(next.document()->isModified());
+  EXPECT_EQ(next.xrayViews().size(), 2u);
+}
+
+TEST_F(StudioMainWindowTest, OfferedAutosaveCanBeDiscarded) {
+  const auto autosave = m_folder / "autosave.json";
+  {
+    StudioMainWindow crashed(autosave);
+    crashed.document()->setRegistrationOptions({"paper", 3, "siddon"});
+  }
+  ASSERT_TRUE(std::filesystem::exists(autosave));
+  StudioMainWindow next(autosave);
+  QString question;
+  answerNextMessageBox(QMessageBox::Discard, &question);
+  next.offerAutosave();
+  EXPECT_TRUE(question.contains(QStringLiteral("did not close normally"))) << question.toStdString();
+  EXPECT_FALSE(std::filesystem::exists(autosave));
+  EXPECT_FALSE(next.document()->isModified());
+}
+
+TEST_F(StudioMainWindowTest, CloseAsksAboutUnsavedChangesAndCancelKeepsEverything) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  window.document()->setRegistrationOptions({"paper", 5, "siddon"});
+  QString question;
+  answerNextMessageBox(QMessageBox::Cancel, &question);
+  EXPECT_FALSE(window.close());
+  EXPECT_TRUE(question.contains(QStringLiteral("unsaved changes"))) << question.toStdString();
+  EXPECT_TRUE(window.isVisible());
+  EXPECT_EQ(window.document()->registrationOptions().seed, 5u);
+  EXPECT_TRUE(std::filesystem::exists(m_folder / "autosave.json"));
+}
+
+TEST_F(StudioMainWindowTest, SaveNewAndReopenThroughTheWindowWithRecentSessions) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  openBuiltinCase(window);
+  const QString path = QString::fromStdString((m_folder / "mine.fctsession.json").string());
+  ASSERT_TRUE(window.saveSessionTo(path)) << window.lastMessage().toStdString();
+  EXPECT_FALSE(window.document()->isModified());
+  EXPECT_FALSE(std::filesystem::exists(m_folder / "autosave.json"));  // saved: nothing to restore
+  ASSERT_FALSE(window.recentSessions().isEmpty());
+  EXPECT_EQ(window.recentSessions().front(), path);
+  EXPECT_TRUE(window.windowTitle().contains(QStringLiteral("mine.fctsession.json")));
+
+  ASSERT_TRUE(window.newSession());
+  EXPECT_TRUE(window.document()->views().empty());
+  EXPECT_TRUE(window.xrayViews().empty());
+  ASSERT_TRUE(window.openSession(path)) << window.lastMessage().toStdString();
+  EXPECT_EQ(window.document()->views().size(), 2u);
+  EXPECT_TRUE(window.document()->initialPose().has_value());
+  EXPECT_FALSE(window.document()->isModified());
+}
+
+TEST_F(StudioMainWindowTest, BadSessionShowsAMessageAndKeepsTheSession) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  openBuiltinCase(window);
+  ASSERT_TRUE(window.saveSessionTo(QString::fromStdString((m_folder / "good.fctsession.json").string())));
+  std::ofstream(m_folder / "bad.fctsession.json") << "{ \"format\": \"fluoroct-studio-session\", \"version\": 1, ";
+  EXPECT_FALSE(window.openSession(QString::fromStdString((m_folder / "bad.fctsession.json").string())));
+  EXPECT_TRUE(window.lastMessage().startsWith(QStringLiteral("Could not open the session"))) << window.lastMessage().toStdString();
+  EXPECT_TRUE(window.lastMessage().contains(QStringLiteral("bad.fctsession.json")));
+  EXPECT_EQ(window.document()->views().size(), 2u);
+  EXPECT_EQ(window.document()->sessionPath(), m_folder / "good.fctsession.json");
+}
+
+}  // namespace

@@ -1,0 +1,149 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "StudioDocument.h"
+#include "StudioSession.h"
+#include "StudioTestCase.h"
+#include "TestSupport.h"
+
+namespace {
+
+using fct::StudioDocument;
+using fct::StudioSession;
+
+/// A document with every part set: the built-in case, landmarks, poses, ROI and options, a result.
+void fillDocument(StudioDocument& d) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_TRUE(d.loadCt(dir / "ct.nrrd").ok());
+  ASSERT_TRUE(d.loadViews(dir / "views.json").ok());
+  fct::Landmarks landmarks;
+  landmarks.ct = {{"L1", {1.5, -2.0, 3.25}}, {"L2", {10.0, 20.0, -30.0}}};
+  landmarks.imageByView["ap"] = {{"L1", {12.5, 40.0}}};
+  landmarks.imageByView["lateral"] = {{"L2", {100.0, 70.25}}};
+  d.setLandmarks(landmarks);
+  Eigen::Isometry3d initial = Eigen::Isometry3d::Identity();
+  initial.rotate(Eigen::AngleAxisd(0.1, Eigen::Vector3d(1, 2, 3).normalized()));
+  initial.translation() = Eigen::Vector3d(4, -5, 6);
+  d.setInitialPose(initial, QStringLiteral("landmarks (2 pairs)"));
+  fct::RoiParameters roi;
+  roi.windowSize = 9;
+  roi.useThreshold = true;
+  roi.varianceThreshold = 1.7;
+  roi.margin_px = 5;
+  roi.detectFieldOfView = false;
+  d.setRoiParameters(roi);
+  d.setRegistrationOptions({"paper", 42, "raycast"});
+  fct::RegistrationResult result;
+  result.T_initial = initial;
+  result.T_world_from_ct = initial * Eigen::Translation3d(1, 1, 1);
+  result.rotationCentre_ct_mm = {0.5, 1.5, 2.5};
+  result.totalDrrs = 1234;
+  result.totalSeconds = 5.5;
+  result.drrMethod = "raycast";
+  result.viewNames = {"ap", "lateral"};
+  result.cancelled = true;
+  fct::StageReport stage;
+  stage.name = "coarse";
+  stage.metric = "ncc";
+  stage.level = 2;
+  stage.search = "genetic";
+  stage.similarity = 0.75;
+  stage.keptFraction = {0.1, 0.2};
+  result.stages.push_back(stage);
+  result.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  d.setResult(result);
+  d.setResultVerdict(fct::ResultVerdict::Rejected);
+}
+
+void expectSameDocument(const StudioDocument& a, const StudioDocument& b) {
+  ASSERT_TRUE(a.ct() && b.ct());
+  EXPECT_EQ(a.ct()->dims(), b.ct()->dims());
+  EXPECT_EQ(a.ct()->voxels(), b.ct()->voxels());
+  ASSERT_EQ(a.views().size(), b.views().size());
+  for (std::size_t v = 0; v < a.views().size(); ++v) {
+    EXPECT_EQ(a.views()[v].name, b.views()[v].name);
+    EXPECT_EQ(a.views()[v].xray.pixels, b.views()[v].xray.pixels);
+    EXPECT_TRUE(a.views()[v].camera.P_px_from_world().isApprox(b.views()[v].camera.P_px_from_world()));
+  }
+  ASSERT_EQ(a.landmarks().ct.size(), b.landmarks().ct.size());
+  for (std::size_t i = 0; i < a.landmarks().ct.size(); ++i) {
+    EXPECT_EQ(a.landmarks().ct[i].name, b.landmarks().ct[i].name);
+    EXPECT_TRUE(a.landmarks().ct[i].p_ct_mm.isApprox(b.landmarks().ct[i].p_ct_mm));
+  }
+  ASSERT_EQ(a.landmarks().imageByView.size(), b.landmarks().imageByView.size());
+  EXPECT_TRUE(b.landmarks().imageByView.at("lateral").at(0).uv_px.isApprox(Eigen::Vector2d(100.0, 70.25)));
+  ASSERT_TRUE(b.initialPose());
+  EXPECT_TRUE(a.initialPose()->isApprox(*b.initialPose(), 1e-12));
+  EXPECT_EQ(a.initialPoseSource(), b.initialPoseSource());
+  EXPECT_EQ(a.roiParameters(), b.roiParameters());
+  EXPECT_EQ(a.registrationOptions(), b.registrationOptions());
+  ASSERT_TRUE(b.result());
+  EXPECT_TRUE(a.result()->T_world_from_ct.isApprox(b.result()->T_world_from_ct, 1e-12));
+  EXPECT_EQ(b.result()->totalDrrs, 1234);
+  EXPECT_TRUE(b.result()->cancelled);
+  ASSERT_EQ(b.result()->stages.size(), 1u);
+  EXPECT_EQ(b.result()->stages[0].keptFraction, (std::vector<double>{0.1, 0.2}));
+  EXPECT_EQ(b.result()->schedule.stages.size(), a.result()->schedule.stages.size());
+  EXPECT_EQ(b.resultVerdict(), fct::ResultVerdict::Rejected);
+  ASSERT_TRUE(b.truthPose());
+  EXPECT_TRUE(a.truthPose()->isApprox(*b.truthPose(), 1e-12));
+}
+
+TEST(StudioSession, SaveThenOpenGivesTheSameDocument) {
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  StudioDocument original;
+  fillDocument(original);
+  const auto path = fct::test::scratchDir() / "case.fctsession.json";
+  const fct::Status saved = StudioSession::save(original, path);
+  ASSERT_TRUE(saved.ok()) << saved.error();
+  EXPECT_FALSE(original.isModified());
+  EXPECT_EQ(original.sessionPath(), path);
+
+  StudioDocument reopened;
+  const fct::Status opened = StudioSession::open(reopened, path);
+  ASSERT_TRUE(opened.ok()) << opened.error();
+  expectSameDocument(original, reopened);
+  EXPECT_FALSE(reopened.isModified());
+  EXPECT_EQ(reopened.sessionPath(), path);
+}
+
+TEST(StudioSession, BadSessionFileLeavesTheDocumentAsItWas) {
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  StudioDocument document;
+  fillDocument(document);
+  const auto folder = fct::test::scratchDir();
+  // Valid JSON, but the CT it names is gone: refused before anything changes.
+  std::ofstream(folder / "gone.fctsession.json")
+      << R"({"format": "fluoroct-studio-session", "version": 1, "ct": {"path": "missing.nrrd"}})";
+  const fct::Status missing = StudioSession::open(document, folder / "gone.fctsession.json");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("missing.nrrd"), std::string::npos) << missing.error();
+  std::ofstream(folder / "other.json") << R"({"views": []})";
+  const fct::Status other = StudioSession::open(document, folder / "other.json");
+  ASSERT_FALSE(other.ok());
+  EXPECT_NE(other.error().find("format"), std::string::npos) << other.error();
+  EXPECT_EQ(document.views().size(), 2u);
+  EXPECT_EQ(document.landmarks().ct.size(), 2u);
+  EXPECT_TRUE(document.result());
+  EXPECT_TRUE(document.isModified());
+}
+
+TEST(StudioSession, AutosaveReopensModifiedAndRemembersItsSessionFile) {
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  StudioDocument document;
+  fillDocument(document);
+  const auto folder = fct::test::scratchDir();
+  ASSERT_TRUE(StudioSession::save(document, folder / "mine.fctsession.json").ok());
+  document.setRegistrationOptions({"fast", 7, "siddon"});
+  ASSERT_TRUE(StudioSession::writeAutosave(document, folder / "autosave" / "side.json").ok());
+  EXPECT_EQ(StudioSession::autosaveOwner(folder / "autosave" / "side.json"), folder / "mine.fctsession.json");
+
+  StudioDocument restored;
+  ASSERT_TRUE(StudioSession::open(restored, folder / "autosave" / "side.json").ok());
+  EXPECT_TRUE(restored.isModified());
+  EXPECT_EQ(restored.sessionPath(), folder / "mine.fctsession.json");
+  EXPECT_EQ(restored.registrationOptions().seed, 7u);
+}
+
+}  // namespace
