@@ -1,0 +1,238 @@
+#include "StudioDocument.h"
+
+#include <fmt/core.h>
+
+#include <set>
+#include <utility>
+
+#include "CtLoader.h"
+#include "DrrRendererFactory.h"
+#include "PoseFile.h"
+#include "ViewFile.h"
+#include "XrayLoader.h"
+
+namespace fct {
+
+namespace fs = std::filesystem;
+
+StudioDocument::StudioDocument(QObject* parent) : QObject(parent) {}
+
+StudioDocument::~StudioDocument() = default;
+
+void StudioDocument::touch() {
+  setModified(true);
+  emit changed();
+}
+
+void StudioDocument::setModified(bool modified) {
+  if (modified == m_modified) return;
+  m_modified = modified;
+  emit modifiedChanged(modified);
+}
+
+Status StudioDocument::loadCt(const fs::path& path, const DicomSeriesReadOptions& options) {
+  auto ct = CtLoader::load(path, options);
+  if (!ct) return fail(ct.error());
+  std::vector<std::string> warnings = ct.warnings();
+  setCt(std::make_shared<const Volume>(std::move(ct).value()), path, std::move(warnings), options.seriesInstanceUid);
+  return Ok{};
+}
+
+void StudioDocument::setCt(std::shared_ptr<const Volume> ct, fs::path path, std::vector<std::string> warnings,
+                           std::string seriesUid) {
+  m_ct = std::move(ct);
+  m_ctPath = std::move(path);
+  m_ctWarnings = std::move(warnings);
+  m_ctSeriesUid = std::move(seriesUid);
+  invalidateCase();
+  emit ctChanged();
+  touch();
+}
+
+Status StudioDocument::loadViews(const fs::path& viewFile) {
+  auto specs = ViewFile::read(viewFile);
+  if (!specs) return fail(specs.error());
+  std::vector<std::string> warnings = specs.warnings();
+  std::vector<RegistrationView> views;
+  for (const ViewSpec& spec : specs.value()) {
+    if (spec.imagePath.empty()) {
+      return fail(fmt::format("{}: view '{}' has no image; add the key \"image\" with the X-ray file of the view",
+                              viewFile.string(), spec.name));
+    }
+    auto image = XrayLoader::load(spec.imagePath, spec.frame);
+    if (!image) return fail(fmt::format("{}: view '{}': {}", viewFile.string(), spec.name, image.error()));
+    for (const std::string& warning : image.warnings()) warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
+    RegistrationView view{spec.name, std::move(image).value(), spec.camera, {}};
+    if (view.xray.cols != spec.camera.intrinsics().cols || view.xray.rows != spec.camera.intrinsics().rows) {
+      return fail(fmt::format("{}: view '{}': the image is {}x{} pixels but the detector is {}x{}; fix the view "
+                              "file's detector size or give the matching image",
+                              viewFile.string(), spec.name, view.xray.cols, view.xray.rows,
+                              spec.camera.intrinsics().cols, spec.camera.intrinsics().rows));
+    }
+    for (const CalibrationSphere& sphere : spec.calibrationSpheres) {
+      view.spheres.push_back(PixelCircle{sphere.center_px, sphere.radius_px});
+    }
+    views.push_back(std::move(view));
+  }
+  std::optional<Eigen::Isometry3d> truth;
+  const fs::path truthPath = viewFile.parent_path() / "truth_pose.json";
+  std::error_code ec;
+  if (fs::exists(truthPath, ec)) {
+    auto pose = PoseFile::read(truthPath);
+    if (pose) {
+      truth = pose.value();
+    } else {
+      warnings.push_back("ground truth not used: " + pose.error());
+    }
+  }
+  setViews(std::move(views), viewFile, std::move(warnings));
+  setTruthPose(truth);
+  return Ok{};
+}
+
+Status StudioDocument::addXrayFile(const fs::path& path) {
+  auto image = XrayLoader::load(path);
+  if (!image) return fail(image.error());
+  if (!image.value().camera) {
+    return fail(fmt::format("{} has no C-arm geometry (DICOM distance and angle tags); open a view file that lists "
+                            "this image with its calibrated camera instead",
+                            path.string()));
+  }
+  std::set<std::string> names;
+  for (const RegistrationView& view : m_views) names.insert(view.name);
+  std::string name = path.stem().string();
+  for (int n = 2; names.count(name); ++n) name = fmt::format("{}-{}", path.stem().string(), n);
+  std::vector<RegistrationView> views = m_views;
+  Camera camera = *image.value().camera;
+  views.push_back(RegistrationView{name, std::move(image).value(), camera, {}});
+  std::vector<std::string> warnings = m_viewWarnings;
+  setViews(std::move(views), {}, std::move(warnings));
+  return Ok{};
+}
+
+void StudioDocument::setViews(std::vector<RegistrationView> views, fs::path viewFile, std::vector<std::string> warnings) {
+  m_views = std::move(views);
+  m_viewFilePath = std::move(viewFile);
+  m_viewWarnings = std::move(warnings);
+  invalidateCase();
+  emit viewsChanged();
+  touch();
+}
+
+int StudioDocument::viewIndex(const std::string& name) const {
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    if (m_views[v].name == name) return static_cast<int>(v);
+  }
+  return -1;
+}
+
+void StudioDocument::setLandmarks(Landmarks landmarks) {
+  m_landmarks = std::move(landmarks);
+  emit landmarksChanged();
+  touch();
+}
+
+void StudioDocument::setInitialPose(std::optional<Eigen::Isometry3d> T_world_from_ct, QString source) {
+  m_initialPose = std::move(T_world_from_ct);
+  m_initialPoseSource = m_initialPose ? std::move(source) : QString();
+  emit initialPoseChanged();
+  touch();
+}
+
+void StudioDocument::setRoiParameters(const RoiParameters& parameters) {
+  if (parameters == m_roi) return;
+  const bool exclusionsChanged = parameters.margin_px != m_roi.margin_px ||
+                                 parameters.detectFieldOfView != m_roi.detectFieldOfView ||
+                                 parameters.detectSpheres != m_roi.detectSpheres ||
+                                 parameters.sphereMargin_px != m_roi.sphereMargin_px;
+  m_roi = parameters;
+  if (exclusionsChanged) invalidateCase();
+  emit roiParametersChanged();
+  touch();
+}
+
+void StudioDocument::setRegistrationOptions(const StudioRegistrationOptions& options) {
+  if (options == m_options) return;
+  if (options.drrMethod != m_options.drrMethod) invalidateCase();
+  m_options = options;
+  emit registrationOptionsChanged();
+  touch();
+}
+
+XrayPreparationOptions StudioDocument::preparationOptions() const {
+  XrayPreparationOptions preparation;
+  preparation.detectFieldOfView = m_roi.detectFieldOfView;
+  preparation.margin_px = m_roi.margin_px;
+  preparation.detectSpheres = m_roi.detectSpheres;
+  preparation.sphereMargin_px = m_roi.sphereMargin_px;
+  return preparation;
+}
+
+Result<std::shared_ptr<RegistrationCase>> StudioDocument::preparedCase() {
+  if (m_case) return m_case;
+  if (!m_ct) return fail("no CT loaded; open a CT in the Data step first");
+  if (m_views.empty()) return fail("no X-ray views loaded; open a view file in the Data step first");
+  auto method = DrrRendererFactory::parseMethod(m_options.drrMethod);
+  if (!method) return fail(method.error());
+  RegistrationCaseOptions options;
+  options.drr.method = method.value();
+  options.preparation = preparationOptions();
+  auto created = RegistrationCase::create(*m_ct, m_views, options);
+  if (!created) return fail(created.error());
+  Result<std::shared_ptr<RegistrationCase>> prepared(std::make_shared<RegistrationCase>(std::move(created).value()));
+  for (const std::string& warning : created.warnings()) prepared.addWarning(warning);
+  m_case = prepared.value();
+  return prepared;
+}
+
+void StudioDocument::setResult(std::optional<RegistrationResult> result) {
+  m_result = std::move(result);
+  m_verdict = ResultVerdict::Undecided;
+  emit resultChanged();
+  touch();
+}
+
+void StudioDocument::setResultVerdict(ResultVerdict verdict) {
+  if (verdict == m_verdict) return;
+  m_verdict = verdict;
+  emit resultChanged();
+  touch();
+}
+
+void StudioDocument::setTruthPose(std::optional<Eigen::Isometry3d> T_world_from_ct) {
+  m_truthPose = std::move(T_world_from_ct);
+  emit truthPoseChanged();
+  touch();
+}
+
+void StudioDocument::clear() {
+  m_ct.reset();
+  m_ctPath.clear();
+  m_ctSeriesUid.clear();
+  m_ctWarnings.clear();
+  m_views.clear();
+  m_viewFilePath.clear();
+  m_viewWarnings.clear();
+  m_landmarks = {};
+  m_initialPose.reset();
+  m_initialPoseSource.clear();
+  m_roi = {};
+  m_options = {};
+  m_result.reset();
+  m_verdict = ResultVerdict::Undecided;
+  m_truthPose.reset();
+  m_sessionPath.clear();
+  invalidateCase();
+  emit ctChanged();
+  emit viewsChanged();
+  emit landmarksChanged();
+  emit initialPoseChanged();
+  emit roiParametersChanged();
+  emit registrationOptionsChanged();
+  emit resultChanged();
+  emit truthPoseChanged();
+  emit changed();
+  setModified(false);
+}
+
+}  // namespace fct

@@ -1,0 +1,190 @@
+#pragma once
+// StudioDocument: the state of one FluoroCT Studio session, shared by every step widget and view: the CT, the C-arm
+// views with their X-rays, the landmarks, the initial pose, the ROI parameters, the registration options and the last
+// result. Setters emit one specific signal per part and `changed()`; any change marks the document modified.
+// Loading goes through Core (CtLoader, ViewFile, XrayLoader) and never throws: failures come back as a Status whose
+// message says what to do, and leave the document as it was.
+
+#include <Eigen/Geometry>
+#include <QObject>
+#include <QString>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "DicomSeriesReader.h"
+#include "Landmarks.h"
+#include "Registration.h"
+#include "RegistrationCase.h"
+#include "Result.h"
+#include "Volume.h"
+
+namespace fct {
+
+/// How the dynamic ROIs are chosen and which pixels are excluded (full-resolution pixels unless said otherwise).
+struct RoiParameters {
+  int windowSize = 7;               ///< w of the w x w windows, pixels of the level they are chosen on
+  bool useThreshold = false;        ///< true: keep windows with normalized variance >= varianceThreshold
+  double targetFraction = 0.12;     ///< false: keep this fraction of the valid pixels (0 < f <= 1)
+  double varianceThreshold = 1.0;   ///< normalized-variance threshold (window variance / image variance)
+  int margin_px = 8;                ///< band along the image borders excluded
+  bool detectFieldOfView = true;    ///< detect the circular / collimated field of view and exclude outside it
+  bool detectSpheres = false;       ///< also detect calibration-sphere shadows (view-file spheres are always used)
+  double sphereMargin_px = 2.0;     ///< added to each sphere's radius when excluding it
+
+  bool operator==(const RoiParameters&) const = default;
+};
+
+/// What the Register step runs.
+struct StudioRegistrationOptions {
+  std::string preset = "fast";       ///< built-in preset name ("fast", "paper") or a preset JSON file
+  std::uint32_t seed = 1;            ///< seed of the random searches
+  std::string drrMethod = "siddon";  ///< DRR method (DrrRendererFactory names)
+
+  bool operator==(const StudioRegistrationOptions&) const = default;
+};
+
+/// The user's verdict on a registration result.
+enum class ResultVerdict { Undecided, Accepted, Rejected };
+
+/// The workstation state of one session.
+class StudioDocument : public QObject {
+  Q_OBJECT
+ public:
+  /// An empty, unmodified document.
+  explicit StudioDocument(QObject* parent = nullptr);
+  ~StudioDocument() override;
+
+  // --- CT -------------------------------------------------------------------------------------------------------
+  /// The CT (HU, LPS mm), or null when none is loaded.
+  const std::shared_ptr<const Volume>& ct() const { return m_ct; }
+  /// The file or folder the CT was loaded from (empty if none or set in memory).
+  const std::filesystem::path& ctPath() const { return m_ctPath; }
+  /// DICOM series UID chosen when the CT came from a folder (empty: the largest series).
+  const std::string& ctSeriesUid() const { return m_ctSeriesUid; }
+  /// Warnings of the CT load (resampling, ...), in words.
+  const std::vector<std::string>& ctWarnings() const { return m_ctWarnings; }
+  /// Loads a CT file or DICOM folder through CtLoader. On failure the document is unchanged and the Status says why.
+  Status loadCt(const std::filesystem::path& path, const DicomSeriesReadOptions& options = {});
+  /// Replaces the CT (null clears it) with its source and warnings; emits ctChanged().
+  void setCt(std::shared_ptr<const Volume> ct, std::filesystem::path path = {}, std::vector<std::string> warnings = {},
+             std::string seriesUid = {});
+
+  // --- Views ----------------------------------------------------------------------------------------------------
+  /// The C-arm views with their X-ray images and cameras.
+  const std::vector<RegistrationView>& views() const { return m_views; }
+  /// The view file they came from (empty if added otherwise).
+  const std::filesystem::path& viewFilePath() const { return m_viewFilePath; }
+  /// Warnings of the view load, in words.
+  const std::vector<std::string>& viewWarnings() const { return m_viewWarnings; }
+  /// Reads a view file (ViewFile) and every view's image (XrayLoader); also reads truth_pose.json beside the view
+  /// file as the ground truth if present. On any failure the document is unchanged and the Status names the view.
+  Status loadViews(const std::filesystem::path& viewFile);
+  /// Adds one X-ray file (DICOM or PNG/TIFF) as a view; it needs its own geometry (DICOM C-arm tags), otherwise the
+  /// Status says to use a view file. The view is named after the file (made unique). Emits viewsChanged().
+  Status addXrayFile(const std::filesystem::path& path);
+  /// Replaces the views and the view file path; emits viewsChanged().
+  void setViews(std::vector<RegistrationView> views, std::filesystem::path viewFile = {},
+                std::vector<std::string> warnings = {});
+  /// Index of the view with this name, or -1.
+  int viewIndex(const std::string& name) const;
+
+  // --- Landmarks and initial pose ------------------------------------------------------------------------------
+  /// CT landmarks and, per view name, their clicked X-ray partners.
+  const Landmarks& landmarks() const { return m_landmarks; }
+  /// Replaces the landmarks; emits landmarksChanged().
+  void setLandmarks(Landmarks landmarks);
+  /// The initial pose T_world_from_ct (LPS mm), if set.
+  const std::optional<Eigen::Isometry3d>& initialPose() const { return m_initialPose; }
+  /// Where the initial pose came from, in words ("landmarks (4 pairs)", "preset supine AP", "pose file ...").
+  const QString& initialPoseSource() const { return m_initialPoseSource; }
+  /// Sets (or clears, with nullopt) the initial pose; emits initialPoseChanged().
+  void setInitialPose(std::optional<Eigen::Isometry3d> T_world_from_ct, QString source = {});
+
+  // --- ROI parameters and registration options ------------------------------------------------------------------
+  /// The dynamic-ROI parameters and exclusions.
+  const RoiParameters& roiParameters() const { return m_roi; }
+  /// Replaces them; emits roiParametersChanged() when they differ.
+  void setRoiParameters(const RoiParameters& parameters);
+  /// The registration options.
+  const StudioRegistrationOptions& registrationOptions() const { return m_options; }
+  /// Replaces them; emits registrationOptionsChanged() when they differ.
+  void setRegistrationOptions(const StudioRegistrationOptions& options);
+  /// The XrayPreparation options of the ROI parameters' exclusions (view spheres are added per view by the case).
+  XrayPreparationOptions preparationOptions() const;
+  /// The registration case of the current CT, views, exclusions and DRR method, prepared on first call and kept
+  /// until one of those changes. Slow on first call (seconds for a large CT). Shared with whoever runs on it: do not
+  /// call while a registration runs on another thread. Fails when the CT or the views are missing, or as
+  /// RegistrationCase::create.
+  Result<std::shared_ptr<RegistrationCase>> preparedCase();
+
+  // --- Result and ground truth ------------------------------------------------------------------------------------
+  /// The last registration result, if any.
+  const std::optional<RegistrationResult>& result() const { return m_result; }
+  /// The user's verdict on it.
+  ResultVerdict resultVerdict() const { return m_verdict; }
+  /// Replaces the result (verdict reset to Undecided); emits resultChanged().
+  void setResult(std::optional<RegistrationResult> result);
+  /// Records accept or reject of the current result; emits resultChanged().
+  void setResultVerdict(ResultVerdict verdict);
+  /// The known true pose of a simulated case (T_world_from_ct), if any.
+  const std::optional<Eigen::Isometry3d>& truthPose() const { return m_truthPose; }
+  /// Sets or clears the ground truth; emits truthPoseChanged().
+  void setTruthPose(std::optional<Eigen::Isometry3d> T_world_from_ct);
+
+  // --- Session bookkeeping ------------------------------------------------------------------------------------------
+  /// True when there are changes not saved to the session file.
+  bool isModified() const { return m_modified; }
+  /// Sets the modified flag; emits modifiedChanged() when it changes.
+  void setModified(bool modified);
+  /// The session file this document was last saved to or opened from (empty if none).
+  const std::filesystem::path& sessionPath() const { return m_sessionPath; }
+  /// Sets the session file path (does not save).
+  void setSessionPath(std::filesystem::path path) { m_sessionPath = std::move(path); }
+  /// Empties the document (new session): every part cleared, not modified, no session path. Emits every signal.
+  void clear();
+
+ signals:
+  void ctChanged();
+  void viewsChanged();
+  void landmarksChanged();
+  void initialPoseChanged();
+  void roiParametersChanged();
+  void registrationOptionsChanged();
+  void resultChanged();
+  void truthPoseChanged();
+  /// Emitted after any change of the content (for autosave and the title bar).
+  void changed();
+  void modifiedChanged(bool modified);
+
+ private:
+  /// Marks modified and emits changed().
+  void touch();
+  /// Drops the prepared case.
+  void invalidateCase() { m_case.reset(); }
+
+  std::shared_ptr<const Volume> m_ct;
+  std::filesystem::path m_ctPath;
+  std::string m_ctSeriesUid;
+  std::vector<std::string> m_ctWarnings;
+  std::vector<RegistrationView> m_views;
+  std::filesystem::path m_viewFilePath;
+  std::vector<std::string> m_viewWarnings;
+  Landmarks m_landmarks;
+  std::optional<Eigen::Isometry3d> m_initialPose;
+  QString m_initialPoseSource;
+  RoiParameters m_roi;
+  StudioRegistrationOptions m_options;
+  std::optional<RegistrationResult> m_result;
+  ResultVerdict m_verdict = ResultVerdict::Undecided;
+  std::optional<Eigen::Isometry3d> m_truthPose;
+  bool m_modified = false;
+  std::filesystem::path m_sessionPath;
+  std::shared_ptr<RegistrationCase> m_case;
+};
+
+}  // namespace fct
