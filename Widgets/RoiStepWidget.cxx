@@ -114,7 +114,24 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
 
   connect(m_levelCombo, &QComboBox::currentIndexChanged, this, &RoiStepWidget::setLevel);
   connect(m_windowSpin, &QSpinBox::valueChanged, this, &RoiStepWidget::pushParameters);
-  connect(m_thresholdRadio, &QRadioButton::toggled, this, &RoiStepWidget::pushParameters);
+  connect(m_thresholdRadio, &QRadioButton::toggled, this, [this](bool threshold) {
+    // Switching to the threshold keeps the selection: the threshold starts where the fraction was (mean over views).
+    if (threshold && !m_selectors.empty()) {
+      double sum = 0.0;
+      int count = 0;
+      for (const DynamicRoiSelector& selector : m_selectors) {
+        if (auto selection = selector.selectFraction(m_document->roiParameters().targetFraction)) {
+          sum += selection.value().threshold;
+          ++count;
+        }
+      }
+      if (count > 0) {
+        const QSignalBlocker blocker(m_thresholdSpin);
+        m_thresholdSpin->setValue(sum / count);
+      }
+    }
+    pushParameters();
+  });
   connect(m_thresholdSlider, &QSlider::valueChanged, this, [this](int value) {
     const QSignalBlocker blocker(m_thresholdSpin);
     m_thresholdSpin->setValue(thresholdForSlider(value));

@@ -10,34 +10,13 @@
 #include "StepTestSession.h"
 #include "TestSupport.h"
 
-namespace {
-
-/// Bone-surface points far apart: the extremes along LPS x, y and z, each at least 20 mm from the others.
-std::vector<Eigen::Vector3d> spreadBonePoints(const fct::BoneSurface& bone) {
-  std::vector<Eigen::Vector3d> picked;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int sign : {-1, 1}) {
-      const auto& points = bone.points_ct_mm();
-      const Eigen::Vector3d extreme = *std::max_element(points.begin(), points.end(), [&](const auto& a, const auto& b) {
-        return sign * a[axis] < sign * b[axis];
-      });
-      const bool farFromOthers = std::all_of(picked.begin(), picked.end(),
-                                             [&](const Eigen::Vector3d& p) { return (p - extreme).norm() > 20.0; });
-      if (farFromOthers) picked.push_back(extreme);
-    }
-  }
-  return picked;
-}
-
-}  // namespace
-
 TEST(LandmarkStepWidget, ClickedLandmarkPairsGiveAnInitialPoseWithin3mm) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   fct::LandmarkStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
 
-  const auto targets = spreadBonePoints(*session.bone);
+  const auto targets = session.spreadBonePoints();
   for (std::size_t i = 0; i < targets.size(); ++i) {
     session.clickCt(targets[i]);
     ASSERT_EQ(session.document.landmarks().ct.size(), i + 1) << step.message().toStdString();
@@ -73,7 +52,7 @@ TEST(LandmarkStepWidget, FewerThanFourLandmarksShowAMessageAndLoseNothing) {
   fct::LandmarkStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
-  const auto targets = spreadBonePoints(*session.bone);
+  const auto targets = session.spreadBonePoints();
   for (int i = 0; i < 3; ++i) {
     step.addCtLandmark(targets[static_cast<std::size_t>(i)]);
     const Eigen::Vector2d uv = session.document.views()[0].camera.project(session.T_truth * targets[static_cast<std::size_t>(i)]);

@@ -2,6 +2,7 @@
 // the kept fraction per view as expected; the overlay layers appear; exclusions are editable.
 #include <gtest/gtest.h>
 
+#include <QRadioButton>
 #include <QSlider>
 
 #include <cmath>
@@ -102,4 +103,20 @@ TEST(RoiStepWidget, ExclusionsAreEditableAndAThresholdAboveEveryWindowSaysSo) {
   EXPECT_NE(step.message().indexOf(QStringLiteral("Lower the threshold")), -1) << step.message().toStdString();
   EXPECT_EQ(session.document.roiParameters().targetFraction, fractionBefore)
       << "the registration's fraction stays as it was";
+}
+
+TEST(RoiStepWidget, SwitchingToTheThresholdStartsWhereTheFractionWas) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RoiStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  step.fractionSlider()->setValue(15);
+  const double before = step.keptFraction(0);
+  auto* thresholdRadio = step.findChild<QRadioButton*>(QString(), Qt::FindChildrenRecursively);
+  ASSERT_NE(thresholdRadio, nullptr);
+  ASSERT_EQ(thresholdRadio->text(), QStringLiteral("Variance threshold"));
+  thresholdRadio->click();
+  EXPECT_TRUE(session.document.roiParameters().useThreshold);
+  EXPECT_NEAR(step.keptFraction(0), before, 0.08) << "about the same pixels as before the switch";
+  EXPECT_GT(step.keptFraction(0), 0.0);
 }

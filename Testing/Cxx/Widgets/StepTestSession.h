@@ -11,6 +11,7 @@
 #include <QTest>
 #include <QWidget>
 
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <memory>
@@ -76,6 +77,42 @@ struct StepTestSession {
   /// Mean bone-surface distance of a pose from the truth, mm.
   double surfaceError_mm(const Eigen::Isometry3d& T_world_from_ct) const {
     return bone->meanDistance_mm(T_world_from_ct, T_truth);
+  }
+
+  /// Up to six bone-surface points far apart, for landmarks: the extremes along LPS x, y and z among the points whose
+  /// true projections lie at least 12 px inside every view, each at least 20 mm from the others and projecting at
+  /// least 10 px from the others in every view (so a click never lands on an earlier landmark's marker).
+  std::vector<Eigen::Vector3d> spreadBonePoints() const {
+    const auto& views = document.views();
+    const auto uvOf = [&](std::size_t v, const Eigen::Vector3d& p) { return views[v].camera.project(T_truth * p); };
+    std::vector<Eigen::Vector3d> visible;
+    for (const Eigen::Vector3d& p : bone->points_ct_mm()) {
+      bool inside = true;
+      for (std::size_t v = 0; v < views.size(); ++v) {
+        const Eigen::Vector2d uv = uvOf(v, p);
+        inside = inside && uv.x() >= 12 && uv.y() >= 12 && uv.x() <= views[v].xray.cols - 13 &&
+                 uv.y() <= views[v].xray.rows - 13;
+      }
+      if (inside) visible.push_back(p);
+    }
+    std::vector<Eigen::Vector3d> picked;
+    if (visible.empty()) return picked;
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int sign : {-1, 1}) {
+        const Eigen::Vector3d extreme = *std::max_element(visible.begin(), visible.end(), [&](const auto& a, const auto& b) {
+          return sign * a[axis] < sign * b[axis];
+        });
+        const bool apart = std::all_of(picked.begin(), picked.end(), [&](const Eigen::Vector3d& p) {
+          if ((p - extreme).norm() <= 20.0) return false;
+          for (std::size_t v = 0; v < views.size(); ++v) {
+            if ((uvOf(v, p) - uvOf(v, extreme)).norm() < 10.0) return false;
+          }
+          return true;
+        });
+        if (apart) picked.push_back(extreme);
+      }
+    }
+    return picked;
   }
 
   /// Clicks a CT point in the axial view (the slice moved to it first) like a user.
