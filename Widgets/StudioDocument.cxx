@@ -30,12 +30,23 @@ void StudioDocument::setModified(bool modified) {
   emit modifiedChanged(modified);
 }
 
-Status StudioDocument::loadCt(const fs::path& path, const DicomSeriesReadOptions& options) {
+Result<LoadedCt> StudioDocument::readCt(const fs::path& path, const DicomSeriesReadOptions& options) {
   auto ct = CtLoader::load(path, options);
   if (!ct) return fail(ct.error());
   std::vector<std::string> warnings = ct.warnings();
-  setCt(std::make_shared<const Volume>(std::move(ct).value()), path, std::move(warnings), options.seriesInstanceUid);
+  return LoadedCt{std::make_shared<const Volume>(std::move(ct).value()), path, options.seriesInstanceUid,
+                  std::move(warnings)};
+}
+
+Status StudioDocument::loadCt(const fs::path& path, const DicomSeriesReadOptions& options) {
+  auto loaded = readCt(path, options);
+  if (!loaded) return fail(loaded.error());
+  setCt(std::move(loaded).value());
   return Ok{};
+}
+
+void StudioDocument::setCt(LoadedCt loaded) {
+  setCt(std::move(loaded.ct), std::move(loaded.path), std::move(loaded.warnings), std::move(loaded.seriesUid));
 }
 
 void StudioDocument::setCt(std::shared_ptr<const Volume> ct, fs::path path, std::vector<std::string> warnings,
@@ -49,7 +60,7 @@ void StudioDocument::setCt(std::shared_ptr<const Volume> ct, fs::path path, std:
   touch();
 }
 
-Status StudioDocument::loadViews(const fs::path& viewFile) {
+Result<LoadedViews> StudioDocument::readViews(const fs::path& viewFile) {
   auto specs = ViewFile::read(viewFile);
   if (!specs) return fail(specs.error());
   std::vector<std::string> warnings = specs.warnings();
@@ -85,9 +96,19 @@ Status StudioDocument::loadViews(const fs::path& viewFile) {
       warnings.push_back("ground truth not used: " + pose.error());
     }
   }
-  setViews(std::move(views), viewFile, std::move(warnings));
-  setTruthPose(truth);
+  return LoadedViews{std::move(views), viewFile, std::move(warnings), truth};
+}
+
+Status StudioDocument::loadViews(const fs::path& viewFile) {
+  auto loaded = readViews(viewFile);
+  if (!loaded) return fail(loaded.error());
+  setViews(std::move(loaded).value());
   return Ok{};
+}
+
+void StudioDocument::setViews(LoadedViews loaded) {
+  setViews(std::move(loaded.views), std::move(loaded.viewFile), std::move(loaded.warnings));
+  setTruthPose(loaded.truthPose);
 }
 
 Status StudioDocument::addXrayFile(const fs::path& path) {

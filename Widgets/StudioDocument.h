@@ -51,6 +51,22 @@ struct StudioRegistrationOptions {
 /// The user's verdict on a registration result.
 enum class ResultVerdict { Undecided, Accepted, Rejected };
 
+/// A CT read from disk, ready to be put into a document (see StudioDocument::readCt).
+struct LoadedCt {
+  std::shared_ptr<const Volume> ct;
+  std::filesystem::path path;
+  std::string seriesUid;
+  std::vector<std::string> warnings;
+};
+
+/// Views read from a view file with their X-rays, ready to be put into a document (see StudioDocument::readViews).
+struct LoadedViews {
+  std::vector<RegistrationView> views;
+  std::filesystem::path viewFile;
+  std::vector<std::string> warnings;
+  std::optional<Eigen::Isometry3d> truthPose;  ///< truth_pose.json beside the view file, if present
+};
+
 /// The workstation state of one session.
 class StudioDocument : public QObject {
   Q_OBJECT
@@ -68,8 +84,12 @@ class StudioDocument : public QObject {
   const std::string& ctSeriesUid() const { return m_ctSeriesUid; }
   /// Warnings of the CT load (resampling, ...), in words.
   const std::vector<std::string>& ctWarnings() const { return m_ctWarnings; }
-  /// Loads a CT file or DICOM folder through CtLoader. On failure the document is unchanged and the Status says why.
+  /// Reads a CT file or DICOM folder through CtLoader without touching any document (safe on a worker thread).
+  static Result<LoadedCt> readCt(const std::filesystem::path& path, const DicomSeriesReadOptions& options = {});
+  /// readCt() then setCt(). On failure the document is unchanged and the Status says why.
   Status loadCt(const std::filesystem::path& path, const DicomSeriesReadOptions& options = {});
+  /// Puts a CT read by readCt() into the document; emits ctChanged().
+  void setCt(LoadedCt loaded);
   /// Replaces the CT (null clears it) with its source and warnings; emits ctChanged().
   void setCt(std::shared_ptr<const Volume> ct, std::filesystem::path path = {}, std::vector<std::string> warnings = {},
              std::string seriesUid = {});
@@ -81,9 +101,14 @@ class StudioDocument : public QObject {
   const std::filesystem::path& viewFilePath() const { return m_viewFilePath; }
   /// Warnings of the view load, in words.
   const std::vector<std::string>& viewWarnings() const { return m_viewWarnings; }
-  /// Reads a view file (ViewFile) and every view's image (XrayLoader); also reads truth_pose.json beside the view
-  /// file as the ground truth if present. On any failure the document is unchanged and the Status names the view.
+  /// Reads a view file (ViewFile) and every view's image (XrayLoader), and truth_pose.json beside the view file as the
+  /// ground truth if present, without touching any document (safe on a worker thread). Fails naming the view.
+  static Result<LoadedViews> readViews(const std::filesystem::path& viewFile);
+  /// readViews() then setViews(). On failure the document is unchanged and the Status says why.
   Status loadViews(const std::filesystem::path& viewFile);
+  /// Puts views read by readViews() into the document with their ground truth; emits viewsChanged() and
+  /// truthPoseChanged().
+  void setViews(LoadedViews loaded);
   /// Adds one X-ray file (DICOM or PNG/TIFF) as a view; it needs its own geometry (DICOM C-arm tags), otherwise the
   /// Status says to use a view file. The view is named after the file (made unique). Emits viewsChanged().
   Status addXrayFile(const std::filesystem::path& path);

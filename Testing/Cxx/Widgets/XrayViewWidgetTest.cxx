@@ -1,0 +1,158 @@
+#include <gtest/gtest.h>
+
+#include <QApplication>
+#include <QSignalSpy>
+#include <QTest>
+#include <QWheelEvent>
+
+#include "XrayViewWidget.h"
+
+namespace {
+
+using fct::OverlayPoint;
+using fct::XrayViewWidget;
+
+/// A 200 x 100 ramp image (value = col + row).
+fct::FloatImage rampImage() {
+  fct::FloatImage image = fct::FloatImage::filled(200, 100);
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) image.at(col, row) = static_cast<float>(col + row);
+  }
+  return image;
+}
+
+void sendWheel(QWidget& widget, QPoint at, int delta, Qt::KeyboardModifiers modifiers = Qt::NoModifier) {
+  QWheelEvent event(QPointF(at), QPointF(widget.mapToGlobal(at)), QPoint(), QPoint(0, delta), Qt::NoButton, modifiers,
+                    Qt::NoScrollPhase, false);
+  QApplication::sendEvent(&widget, &event);
+}
+
+TEST(XrayViewWidget, ClickGivesTheImagePixelAtZoomAndPan) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(rampImage());
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  view.setZoom(2.5);
+  view.setPan(QPointF(30, -20));
+  QSignalSpy spy(&view, &XrayViewWidget::pixelClicked);
+
+  const Eigen::Vector2d target(37.0, 61.0);
+  QTest::mouseClick(&view, Qt::LeftButton, Qt::NoModifier, view.widgetPointForPixel(target));
+  ASSERT_EQ(spy.count(), 1);
+  const auto uv = spy.at(0).at(0).value<Eigen::Vector2d>();
+  // The widget point is rounded to whole widget pixels: 2 px (fit) x 2.5 zoom = 5 widget px per image pixel.
+  EXPECT_NEAR(uv.x(), target.x(), 0.2);
+  EXPECT_NEAR(uv.y(), target.y(), 0.2);
+}
+
+TEST(XrayViewWidget, WheelZoomKeepsThePixelUnderTheCursor) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(rampImage());
+  const QPoint cursor(250, 120);
+  const Eigen::Vector2d before = view.pixelForWidgetPoint(cursor);
+  sendWheel(view, cursor, 240);
+  EXPECT_NEAR(view.zoom(), 1.44, 1e-9);
+  const Eigen::Vector2d after = view.pixelForWidgetPoint(cursor);
+  EXPECT_NEAR(after.x(), before.x(), 1e-6);
+  EXPECT_NEAR(after.y(), before.y(), 1e-6);
+}
+
+TEST(XrayViewWidget, DraggingAPointMovesItAndIsNotAClick) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(rampImage());
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  view.setPointLayer(QStringLiteral("marks"), {OverlayPoint{{50.0, 40.0}, QStringLiteral("L1"), Qt::green}}, true);
+  QSignalSpy clicks(&view, &XrayViewWidget::pixelClicked);
+  QSignalSpy drags(&view, &XrayViewWidget::pointDragged);
+
+  const QPoint from = view.widgetPointForPixel({50.0, 40.0});
+  const QPoint to = view.widgetPointForPixel({70.0, 45.0});
+  QTest::mousePress(&view, Qt::LeftButton, Qt::NoModifier, from);
+  QTest::mouseMove(&view, (from + to) / 2);
+  QTest::mouseMove(&view, to);
+  QTest::mouseRelease(&view, Qt::LeftButton, Qt::NoModifier, to);
+
+  EXPECT_EQ(clicks.count(), 0);
+  ASSERT_GE(drags.count(), 1);
+  const QList<QVariant> last = drags.takeLast();
+  EXPECT_EQ(last.at(0).toString(), QStringLiteral("marks"));
+  EXPECT_EQ(last.at(1).toInt(), 0);
+  const auto uv = last.at(2).value<Eigen::Vector2d>();
+  EXPECT_NEAR(uv.x(), 70.0, 0.5);
+  EXPECT_NEAR(uv.y(), 45.0, 0.5);
+  EXPECT_NEAR(view.layerPoints(QStringLiteral("marks")).at(0).uv_px.x(), 70.0, 0.5);
+}
+
+TEST(XrayViewWidget, LeftDragOnTheImagePansWithoutClicking) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(rampImage());
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  QSignalSpy clicks(&view, &XrayViewWidget::pixelClicked);
+  QTest::mousePress(&view, Qt::LeftButton, Qt::NoModifier, QPoint(100, 100));
+  QTest::mouseMove(&view, QPoint(130, 110));
+  QTest::mouseRelease(&view, Qt::LeftButton, Qt::NoModifier, QPoint(130, 110));
+  EXPECT_EQ(clicks.count(), 0);
+  EXPECT_NEAR(view.pan().x(), 30.0, 1e-9);
+  EXPECT_NEAR(view.pan().y(), 10.0, 1e-9);
+}
+
+TEST(XrayViewWidget, CtrlDragChangesWindowAndLevel) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(rampImage());
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  const double window = view.window();
+  const double level = view.level();
+  QTest::mousePress(&view, Qt::LeftButton, Qt::ControlModifier, QPoint(100, 100));
+  QTest::mouseMove(&view, QPoint(160, 80));
+  QTest::mouseRelease(&view, Qt::LeftButton, Qt::ControlModifier, QPoint(160, 80));
+  EXPECT_GT(view.window(), window);
+  EXPECT_GT(view.level(), level);
+}
+
+TEST(XrayViewWidget, ImageLayerOfAnotherSizeIsRefusedAndClicksOutsideAreIgnored) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(rampImage());
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  QImage wrong(10, 10, QImage::Format_ARGB32);
+  view.setImageLayer(QStringLiteral("rois"), wrong, 0.5);
+  EXPECT_FALSE(view.hasLayer(QStringLiteral("rois")));
+  QImage right(200, 100, QImage::Format_ARGB32);
+  right.fill(Qt::transparent);
+  view.setImageLayer(QStringLiteral("rois"), right, 0.5);
+  EXPECT_TRUE(view.isLayerVisible(QStringLiteral("rois")));
+  view.setLayerVisible(QStringLiteral("rois"), false);
+  EXPECT_FALSE(view.isLayerVisible(QStringLiteral("rois")));
+  EXPECT_TRUE(view.hasLayer(QStringLiteral("rois")));
+
+  QSignalSpy clicks(&view, &XrayViewWidget::pixelClicked);
+  // The 200 x 100 image fits 400 x 200 widget pixels: rows 0..49 and 250..299 of the widget are outside it.
+  QTest::mouseClick(&view, Qt::LeftButton, Qt::NoModifier, QPoint(200, 20));
+  EXPECT_EQ(clicks.count(), 0);
+}
+
+TEST(XrayViewWidget, ShowsAnXrayImageWithARobustWindow) {
+  fct::XrayImage xray;
+  xray.cols = 4;
+  xray.rows = 2;
+  xray.pixels = {0, 10, 20, 30, 40, 50, 60, 70};
+  XrayViewWidget view;
+  view.setImage(xray);
+  EXPECT_EQ(view.imageSize(), QSize(4, 2));
+  EXPECT_GT(view.window(), 0.0);
+  EXPECT_GT(view.level(), 0.0);
+  EXPECT_LT(view.level(), 70.0);
+  view.clear();
+  EXPECT_FALSE(view.hasImage());
+}
+
+}  // namespace
