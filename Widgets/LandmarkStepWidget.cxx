@@ -7,6 +7,7 @@
 #include <QPushButton>
 #include <QTableWidget>
 #include <QVBoxLayout>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -162,7 +163,7 @@ void LandmarkStepWidget::addCtLandmark(const Eigen::Vector3d& p_ct_mm) {
   Landmarks landmarks = m_document->landmarks();
   std::string name;
   for (std::size_t n = landmarks.ct.size() + 1;; ++n) {
-    name = "L" + std::to_string(n);
+    name = fmt::format("L{}", n);
     if (!nameInUse(landmarks, name)) break;
   }
   landmarks.ct.push_back(CtLandmark{name, p_ct_mm});

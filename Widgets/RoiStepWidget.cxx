@@ -1,5 +1,6 @@
 #include "RoiStepWidget.h"
 
+#include <QApplication>
 #include <QButtonGroup>
 #include <QCheckBox>
 #include <QComboBox>
@@ -246,7 +247,9 @@ void RoiStepWidget::pushParameters() {
 }
 
 bool RoiStepWidget::ensureSelectors() {
+  QApplication::setOverrideCursor(Qt::WaitCursor);  // the first call prepares the case (seconds for a large CT)
   auto prepared = m_document->preparedCase();
+  QApplication::restoreOverrideCursor();
   if (!prepared) {
     m_case.reset();
     m_selectors.clear();
