@@ -169,10 +169,15 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
     if (!path.isEmpty()) saveScreenshot(path);
   });
 
-  for (auto signal : {&StudioDocument::resultChanged, &StudioDocument::initialPoseChanged, &StudioDocument::ctChanged,
-                      &StudioDocument::viewsChanged, &StudioDocument::truthPoseChanged}) {
+  for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged, &StudioDocument::truthPoseChanged}) {
     connect(m_document, signal, this, [this] {
       if (m_active) refresh();
+    });
+  }
+  // A verdict also emits resultChanged: redraw only when a pose shown changed.
+  for (auto signal : {&StudioDocument::resultChanged, &StudioDocument::initialPoseChanged}) {
+    connect(m_document, signal, this, [this] {
+      if (m_active && reviewedPoses() != m_shownPoses) refresh();
     });
   }
   connect(m_document, &StudioDocument::resultChanged, this, &ReviewStepWidget::updateVerdict);
@@ -227,17 +232,28 @@ bool ReviewStepWidget::ensureOverlay() {
   return true;
 }
 
+ReviewStepWidget::PosePair ReviewStepWidget::reviewedPoses() const {
+  const auto& result = m_document->result();
+  if (!result) {
+    const auto& initial = m_document->initialPose();
+    return {initial ? std::optional<Eigen::Matrix4d>(initial->matrix()) : std::nullopt, std::nullopt};
+  }
+  return {result->T_initial.matrix(), result->T_world_from_ct.matrix()};
+}
+
 void ReviewStepWidget::refresh() {
   m_initialContours.clear();
   m_finalContours.clear();
   m_drrGrey.clear();
   m_finalTre_mm.reset();
   m_treLabel->clear();
+  m_shownPoses = reviewedPoses();
   const auto& result = m_document->result();
-  const std::optional<Eigen::Isometry3d> initial =
-      result ? std::optional<Eigen::Isometry3d>(result->T_initial) : m_document->initialPose();
-  const std::optional<Eigen::Isometry3d> final =
-      result ? std::optional<Eigen::Isometry3d>(result->T_world_from_ct) : std::nullopt;
+  const auto asPose = [](const std::optional<Eigen::Matrix4d>& matrix) {
+    return matrix ? std::optional<Eigen::Isometry3d>(Eigen::Isometry3d(*matrix)) : std::nullopt;
+  };
+  const std::optional<Eigen::Isometry3d> initial = asPose(m_shownPoses.first);
+  const std::optional<Eigen::Isometry3d> final = asPose(m_shownPoses.second);
   if (!initial && !final) {
     showMessage(tr("Nothing to review yet: set an initial pose and run a registration."), false);
     drawContours();

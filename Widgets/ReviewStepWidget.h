@@ -6,6 +6,7 @@
 // distance to the truth (BoneSurface), is shown for both poses. Accept / Reject record the verdict in the document;
 // the final pose exports as an ITK .tfm for 3D Slicer or as pose JSON, and the X-ray views as a PNG screenshot.
 
+#include <Eigen/Core>
 #include <QColor>
 #include <QString>
 #include <QWidget>
@@ -13,6 +14,7 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "BoneSurface.h"
@@ -85,6 +87,9 @@ class ReviewStepWidget : public QWidget {
   bool saveScreenshot(const QString& path);
 
  private:
+  /// The (initial, final) poses to review as matrices: the result's, or the document's initial pose alone.
+  using PosePair = std::pair<std::optional<Eigen::Matrix4d>, std::optional<Eigen::Matrix4d>>;
+  PosePair reviewedPoses() const;
   /// Builds the bone outline projector and surface for the document's CT when it changed; false with a message.
   bool ensureOverlay();
   /// Redraws the contour layers from the cached contours.
@@ -105,6 +110,7 @@ class ReviewStepWidget : public QWidget {
   std::vector<std::vector<std::vector<Eigen::Vector2d>>> m_finalContours;    ///< per view
   std::vector<QImage> m_drrGrey;                                             ///< per view, 8-bit grey DRR
   std::optional<double> m_finalTre_mm;
+  PosePair m_shownPoses;  ///< the poses the cached contours and DRRs were made for
 
   bool m_showInitial = true;
   bool m_showFinal = true;
