@@ -120,3 +120,20 @@ TEST(RoiStepWidget, SwitchingToTheThresholdStartsWhereTheFractionWas) {
   EXPECT_NEAR(step.keptFraction(0), before, 0.08) << "about the same pixels as before the switch";
   EXPECT_GT(step.keptFraction(0), 0.0);
 }
+
+TEST(RoiStepWidget, CalibrationSpheresAreExcludedAndOutlined) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  std::vector<fct::RegistrationView> views = session.document.views();
+  views[0].spheres.push_back(fct::PixelCircle{Eigen::Vector2d(60.0, 70.0), 6.0});
+  session.document.setViews(views);
+  fct::RoiStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  auto prepared = session.document.preparedCase();
+  ASSERT_TRUE(prepared.ok()) << prepared.error();
+  EXPECT_FALSE(prepared.value()->prepared(0).pyramid.level(0).mask.isValid(60, 70)) << "the sphere is excluded";
+  EXPECT_TRUE(session.xrayViews[0]->isLayerVisible(fct::RoiStepWidget::kSphereLayer));
+  EXPECT_TRUE(std::isfinite(step.keptFraction(0)));
+  step.setActive(false);
+  EXPECT_FALSE(session.xrayViews[0]->isLayerVisible(fct::RoiStepWidget::kSphereLayer)) << "hidden when inactive";
+}
