@@ -95,7 +95,19 @@ RegisterStepWidget::~RegisterStepWidget() {
 
 void RegisterStepWidget::attachViews(std::vector<XrayViewWidget*>, std::array<SliceViewWidget*, 3>) {}
 
-void RegisterStepWidget::setActive(bool) {}
+void RegisterStepWidget::setActive(bool active) {
+  if (!active || m_thread) return;
+  const RoiParameters& roi = m_document->roiParameters();
+  if (!m_document->initialPose()) {
+    showMessage(tr("No initial pose yet: set one in the Initial pose step (landmarks or the supine AP preset)."), true);
+    return;
+  }
+  showMessage(tr("Ready: initial pose from %1; ROIs of %2 px keeping %3 % of the pixels.")
+                  .arg(m_document->initialPoseSource().isEmpty() ? tr("the session") : m_document->initialPoseSource())
+                  .arg(roi.windowSize)
+                  .arg(100.0 * roi.targetFraction, 0, 'f', 1),
+              false);
+}
 
 RegistrationAblation RegisterStepWidget::ablation() const {
   RegistrationAblation ablation;

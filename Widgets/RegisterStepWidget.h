@@ -40,7 +40,7 @@ class RegisterStepWidget : public QWidget {
 
   /// The views (this step draws nothing on them; kept for the common step interface).
   void attachViews(std::vector<XrayViewWidget*> xrayViews, std::array<SliceViewWidget*, 3> sliceViews);
-  /// Active or not, the step keeps running a started registration; activity changes nothing else.
+  /// Activating shows whether the step is ready (initial pose, ROI settings); a started run goes on either way.
   void setActive(bool active);
 
   /// True while a registration runs.

@@ -66,10 +66,15 @@ TEST(RegisterStepWidget, CancelMidRunKeepsTheBestPoseMarkedAndTheWidgetRunsAgain
 TEST(RegisterStepWidget, RefusesToRunWithoutAnInitialPoseOrWithABadPreset) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   fct::RegisterStepWidget step(&session.document);
+  step.setActive(true);
+  EXPECT_NE(step.message().indexOf(QStringLiteral("No initial pose")), -1) << step.message().toStdString();
   EXPECT_FALSE(step.run());
   EXPECT_NE(step.message().indexOf(QStringLiteral("initial pose")), -1) << step.message().toStdString();
   EXPECT_FALSE(step.isRunning());
   setStartPose(session, 3.0);
+  step.setActive(true);
+  EXPECT_NE(step.message().indexOf(QStringLiteral("Ready: initial pose from test start")), -1)
+      << step.message().toStdString();
   fct::StudioRegistrationOptions options = session.document.registrationOptions();
   options.preset = "/nonexistent/preset.json";
   session.document.setRegistrationOptions(options);
