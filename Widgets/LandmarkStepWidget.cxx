@@ -104,11 +104,13 @@ LandmarkStepWidget::LandmarkStepWidget(StudioDocument* document, QWidget* parent
   connect(saveButton, &QPushButton::clicked, this, &LandmarkStepWidget::saveWithDialog);
   connect(m_computeButton, &QPushButton::clicked, this, &LandmarkStepWidget::computePose);
   connect(presetButton, &QPushButton::clicked, this, &LandmarkStepWidget::applySetupPose);
-  connect(m_document, &StudioDocument::landmarksChanged, this, [this] {
-    m_estimate.reset();
-    refresh();
-  });
-  connect(m_document, &StudioDocument::viewsChanged, this, &LandmarkStepWidget::refresh);
+  // A pose estimate belongs to the landmarks and cameras it came from.
+  for (auto signal : {&StudioDocument::landmarksChanged, &StudioDocument::viewsChanged}) {
+    connect(m_document, signal, this, [this] {
+      m_estimate.reset();
+      refresh();
+    });
+  }
   refresh();
 }
 
