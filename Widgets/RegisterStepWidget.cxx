@@ -85,6 +85,11 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   connect(m_seedSpin, &QSpinBox::valueChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_methodCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_document, &StudioDocument::registrationOptionsChanged, this, &RegisterStepWidget::syncControls);
+  for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged}) {
+    connect(m_document, signal, this, [this] {
+      if (m_thread) m_inputsChangedDuringRun = true;
+    });
+  }
   syncControls();
 }
 
@@ -201,6 +206,7 @@ bool RegisterStepWidget::run() {
       m_document->initialPoseSource().toStdString())));
 
   m_lastProgress = RegistrationProgress{};
+  m_inputsChangedDuringRun = false;
   m_worker = new RegistrationWorker(prepared.value(), *initial, std::move(options));
   m_thread = new QThread(this);
   m_worker->moveToThread(m_thread);
@@ -254,9 +260,16 @@ void RegisterStepWidget::onFinished(const RegistrationResult& result) {
     m_progressBar->setValue(m_progressBar->maximum());
     summary = tr("Registered: %1. Judge the result in the Review step.").arg(summary);
   }
-  appendLog(summary);
-  showMessage(summary, false);
-  m_document->setResult(result);
+  if (m_inputsChangedDuringRun) {
+    summary = tr("The CT or the views changed during the run, so its result (%1) was not kept; run again.")
+                  .arg(summary);
+    appendLog(summary);
+    showMessage(summary, true);
+  } else {
+    appendLog(summary);
+    showMessage(summary, false);
+    m_document->setResult(result);
+  }
   setRunningUi(false);
   emit runningChanged(false);
 }

@@ -3,7 +3,8 @@
 // RegistrationWorker on its own thread from the document's initial pose, with the document's ROI window and
 // fraction in every ROI stage; a progress bar (stage, DRRs, best similarity) and a log follow it through queued
 // signals while the window stays responsive. Cancel stops the run at the next DRR set; the best pose so far is kept
-// and marked cancelled. The result (finished or cancelled) goes into the document.
+// and marked cancelled. The result (finished or cancelled) goes into the document, unless the CT or the views changed
+// during the run (then it is reported and dropped).
 
 #include <QString>
 #include <QWidget>
@@ -86,6 +87,7 @@ class RegisterStepWidget : public QWidget {
   QThread* m_thread = nullptr;
   RegistrationWorker* m_worker = nullptr;
   RegistrationProgress m_lastProgress;
+  bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
 
   QComboBox* m_presetCombo;
   QSpinBox* m_seedSpin;

@@ -91,3 +91,14 @@ TEST(RegisterStepWidget, DestroyingTheWidgetDuringARunCancelsItCleanly) {
   step.reset();
   EXPECT_FALSE(session.document.result().has_value()) << "a run cut short by closing stores nothing";
 }
+
+TEST(RegisterStepWidget, AResultOfViewsReplacedDuringTheRunIsNotKept) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  setStartPose(session, 5.0);
+  fct::RegisterStepWidget step(&session.document);
+  ASSERT_TRUE(step.run()) << step.message().toStdString();
+  session.document.setViews(session.document.views());
+  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000));
+  EXPECT_FALSE(session.document.result().has_value());
+  EXPECT_NE(step.message().indexOf(QStringLiteral("changed during the run")), -1) << step.message().toStdString();
+}
