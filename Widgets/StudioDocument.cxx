@@ -111,7 +111,7 @@ void StudioDocument::setViews(LoadedViews loaded) {
   setTruthPose(loaded.truthPose);
 }
 
-Status StudioDocument::addXrayFile(const fs::path& path) {
+Result<RegistrationView> StudioDocument::readXrayFile(const fs::path& path) {
   auto image = XrayLoader::load(path);
   if (!image) return fail(image.error());
   if (!image.value().camera) {
@@ -119,13 +119,35 @@ Status StudioDocument::addXrayFile(const fs::path& path) {
                             "this image with its calibrated camera instead",
                             path.string()));
   }
+  const Camera camera = *image.value().camera;
+  Result<RegistrationView> view(RegistrationView{path.stem().string(), std::move(image).value(), camera, {}});
+  return view;
+}
+
+Status StudioDocument::addXrayFile(const fs::path& path) {
+  auto read = readXrayFile(path);
+  if (!read) return fail(read.error());
+  std::vector<RegistrationView> views;
+  views.push_back(std::move(read).value());
+  return addXrayViews(std::move(views));
+}
+
+Status StudioDocument::addXrayViews(std::vector<RegistrationView> added) {
+  if (!m_viewFilePath.empty()) {
+    const std::string file = added.empty() ? std::string("the X-rays") : added.front().xray.sourcePath;
+    return fail(fmt::format("the views come from the view file {}; list {} in that file, or open the X-ray files "
+                            "alone after File > New session",
+                            m_viewFilePath.string(), file));
+  }
   std::set<std::string> names;
-  for (const RegistrationView& view : m_views) names.insert(view.name);
-  std::string name = path.stem().string();
-  for (int n = 2; names.count(name); ++n) name = fmt::format("{}-{}", path.stem().string(), n);
+  for (const RegistrationView& existing : m_views) names.insert(existing.name);
   std::vector<RegistrationView> views = m_views;
-  Camera camera = *image.value().camera;
-  views.push_back(RegistrationView{name, std::move(image).value(), camera, {}});
+  for (RegistrationView& view : added) {
+    const std::string stem = view.name;
+    for (int n = 2; names.count(view.name); ++n) view.name = fmt::format("{}-{}", stem, n);
+    names.insert(view.name);
+    views.push_back(std::move(view));
+  }
   std::vector<std::string> warnings = m_viewWarnings;
   setViews(std::move(views), {}, std::move(warnings));
   return Ok{};

@@ -1,12 +1,27 @@
 // fluoroct-studio: the FluoroCT desktop program (thin entry point).
+// fluoroct-studio [SESSION | --case DIR] [--step NAME] [--screenshot FILE]
 #include <QApplication>
 #include <QCommandLineParser>
+#include <QDir>
 #include <QPixmap>
+#include <QTemporaryDir>
 #include <QTimer>
 
 #include <cstdio>
+#include <memory>
 
-#include "MainWindow.h"
+#include "DataStepWidget.h"
+#include "StudioMainWindow.h"
+
+namespace {
+
+/// Prints `error: message` on stderr and returns 2.
+int reportError(const QString& message) {
+  std::fprintf(stderr, "error: %s\n", message.toLocal8Bit().constData());
+  return 2;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   QApplication app(argc, argv);
@@ -18,25 +33,74 @@ int main(int argc, char** argv) {
   parser.setApplicationDescription(QStringLiteral("FluoroCT Studio: register a CT to fluoroscopic X-ray images"));
   parser.addHelpOption();
   parser.addVersionOption();
-  const QCommandLineOption screenshot(QStringLiteral("screenshot"),
-                                      QStringLiteral("Save a PNG of the window to <file> once it is shown, then quit."),
-                                      QStringLiteral("file"));
+  parser.addPositionalArgument(QStringLiteral("session"), QStringLiteral("Session file to open (.fctsession.json)."),
+                               QStringLiteral("[SESSION]"));
+  const QCommandLineOption caseFolder(
+      QStringLiteral("case"),
+      QStringLiteral("Open a case folder: ct.nrrd (or ct.nii.gz, ct.mha, a DICOM folder 'ct'), views.json, and "
+                     "optionally initial_pose.json and truth_pose.json."),
+      QStringLiteral("dir"));
+  const QCommandLineOption step(QStringLiteral("step"),
+                                QStringLiteral("Show this workflow step: data, initial-pose, rois, register, review."),
+                                QStringLiteral("name"));
+  const QCommandLineOption screenshot(
+      QStringLiteral("screenshot"),
+      QStringLiteral("Save a PNG of the window to <file> once it is shown (and the case loaded), then quit."),
+      QStringLiteral("file"));
+  parser.addOption(caseFolder);
+  parser.addOption(step);
   parser.addOption(screenshot);
   parser.process(app);
+  const QStringList positional = parser.positionalArguments();
+  if (positional.size() > 1) return reportError(QStringLiteral("give at most one session file"));
+  if (!positional.isEmpty() && parser.isSet(caseFolder)) {
+    return reportError(QStringLiteral("give either a session file or --case DIR, not both"));
+  }
 
-  fct::MainWindow window;
+  // A screenshot run is not a working session: its autosave goes to a throw-away folder.
+  std::unique_ptr<QTemporaryDir> scratch;
+  std::filesystem::path autosavePath;
+  if (parser.isSet(screenshot)) {
+    scratch = std::make_unique<QTemporaryDir>();
+    autosavePath = std::filesystem::path(scratch->path().toStdString()) / "autosave.fctsession.json";
+  }
+  fct::StudioMainWindow window(autosavePath);
+  if (parser.isSet(step) && !window.showStepNamed(parser.value(step))) {
+    QStringList names;
+    for (int i = 0; i < window.stepCount(); ++i) names << window.stepTitle(i).toLower().replace(' ', '-');
+    return reportError(QStringLiteral("no step named '%1'; the steps are: %2")
+                           .arg(parser.value(step), names.join(QStringLiteral(", "))));
+  }
   window.show();
+
+  bool loading = false;
+  if (!positional.isEmpty()) {
+    window.openSession(positional.front());
+  } else if (parser.isSet(caseFolder)) {
+    loading = true;
+    window.dataStep()->openCaseFolder(parser.value(caseFolder));
+  } else if (!parser.isSet(screenshot)) {
+    QTimer::singleShot(0, &window, [&window] { window.offerAutosave(); });
+  }
+
   if (parser.isSet(screenshot)) {
     const QString path = parser.value(screenshot);
-    QTimer::singleShot(500, &window, [&window, path] {
-      if (!window.grab().save(path, "PNG")) {
-        std::fprintf(stderr, "error: could not write the screenshot to '%s'; check the folder exists and is writable\n",
-                     path.toLocal8Bit().constData());
-        QApplication::exit(2);
-        return;
-      }
-      QApplication::quit();
-    });
+    const auto take = [&window, path] {
+      QTimer::singleShot(700, &window, [&window, path] {
+        if (!window.grab().save(path, "PNG")) {
+          std::fprintf(stderr, "error: could not write the screenshot to '%s'; check the folder exists and is writable\n",
+                       path.toLocal8Bit().constData());
+          QApplication::exit(2);
+          return;
+        }
+        QApplication::exit(0);  // not quit(): that would close the window and ask about the unsaved case
+      });
+    };
+    if (loading && window.dataStep()->isBusy()) {
+      QObject::connect(window.dataStep(), &fct::DataStepWidget::loadFinished, &window, take);
+    } else {
+      take();
+    }
   }
   return QApplication::exec();
 }

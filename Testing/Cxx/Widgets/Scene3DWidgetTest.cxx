@@ -1,0 +1,62 @@
+#include <gtest/gtest.h>
+
+#include <QOpenGLContext>
+#include <QTest>
+
+#include "Scene3DWidget.h"
+#include "StudioDocument.h"
+#include "StudioTestCase.h"
+
+namespace {
+
+/// Pixels of `image` whose colour is near the bone colour (pale yellow, lit: red > blue + 30).
+int boneColouredPixels(const QImage& image) {
+  int count = 0;
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      const QColor c = image.pixelColor(x, y);
+      if (c.red() > 90 && c.red() > c.blue() + 30 && c.green() > c.blue() + 15) ++count;
+    }
+  }
+  return count;
+}
+
+TEST(Scene3DWidget, BuildsTheBoneSurfaceAndOneDetectorPerView) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  fct::StudioDocument document;
+  fct::Scene3DWidget scene(&document);
+  EXPECT_EQ(scene.boneTriangleCount(), 0);
+  ASSERT_TRUE(document.loadCt(dir / "ct.nrrd").ok());
+  ASSERT_TRUE(document.loadViews(dir / "views.json").ok());
+  EXPECT_GT(scene.boneTriangleCount(), 1000);
+  EXPECT_EQ(scene.viewCount(), 6);  // per view: detector, source, beam
+  EXPECT_EQ(scene.poseDescription(), QStringLiteral("identity pose (no pose yet)"));
+  document.setInitialPose(Eigen::Isometry3d::Identity(), QStringLiteral("test"));
+  EXPECT_EQ(scene.poseDescription(), QStringLiteral("initial pose"));
+  scene.setBoneThreshold_hu(5000.0);  // above every value of the phantom
+  EXPECT_EQ(scene.boneTriangleCount(), 0);
+}
+
+// Render test: needs an OpenGL context (run under xvfb-run, as scripts/test.sh does); skipped without one.
+TEST(Scene3DWidgetRender, DrawsTheBoneInTheViewport) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  fct::StudioDocument document;
+  ASSERT_TRUE(document.loadCt(dir / "ct.nrrd").ok());
+  fct::Scene3DWidget scene(&document);
+  scene.resize(320, 240);
+  scene.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&scene));
+  if (!scene.context() || !scene.context()->isValid()) {
+    GTEST_SKIP() << "no OpenGL context on this Qt platform (the 'render' CTest runs it with xcb under xvfb-run)";
+  }
+  const QImage image = scene.grabFramebuffer();
+  ASSERT_FALSE(image.isNull());
+  image.save(QStringLiteral("/tmp/fluoroct_tests_scene3d.png"));
+  const int bone = boneColouredPixels(image);
+  EXPECT_GT(bone, 320 * 240 / 50) << "bone-coloured pixels: " << bone;
+  EXPECT_LT(bone, 320 * 240);  // and the background is there too
+}
+
+}  // namespace
