@@ -247,4 +247,21 @@ RegistrationSchedule RegistrationSchedule::withSeed(std::uint32_t seed) const {
   return result;
 }
 
+Result<RegistrationSchedule> RegistrationSchedule::withRoiPixels(int windowSize, double targetFraction) const {
+  if (windowSize < 2 || windowSize > 64) {
+    return fail(fmt::format("ROI window size {} px is outside 2 to 64 px; choose a window in that range", windowSize));
+  }
+  if (!(targetFraction > 0.0 && targetFraction <= 1.0)) {
+    return fail(fmt::format("ROI fraction {} is outside (0, 1]; the paper keeps 0.10 to 0.15 of the pixels",
+                            targetFraction));
+  }
+  RegistrationSchedule result = *this;
+  for (RegistrationStage& stage : result.stages) {
+    if (stage.pixels.kind != PixelSetKind::Rois) continue;
+    stage.pixels.windowSize = windowSize;
+    stage.pixels.targetFraction = targetFraction;
+  }
+  return result;
+}
+
 }  // namespace fct

@@ -84,6 +84,9 @@ class RegistrationSchedule {
   RegistrationSchedule withAblation(const RegistrationAblation& ablation) const;
   /// This schedule with every stage's random seed derived from `seed` (stage i gets seed + i).
   RegistrationSchedule withSeed(std::uint32_t seed) const;
+  /// This schedule with every ROI stage's window size and target fraction replaced (e.g. by the user's tuning);
+  /// stages on whole images are unchanged. Fails on a window outside 2..64 or a fraction outside (0, 1].
+  Result<RegistrationSchedule> withRoiPixels(int windowSize, double targetFraction) const;
 
   /// Lowercase name of a metric ("ncc", "vlnc", "gc").
   static std::string_view metricName(SimilarityMetric metric);

@@ -16,6 +16,10 @@
 #include <QVBoxLayout>
 
 #include "DataStepWidget.h"
+#include "LandmarkStepWidget.h"
+#include "RegisterStepWidget.h"
+#include "ReviewStepWidget.h"
+#include "RoiStepWidget.h"
 #include "Scene3DWidget.h"
 #include "SessionAutosave.h"
 #include "SliceViewWidget.h"
@@ -144,6 +148,10 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   });
   // The workflow steps, in order: one line each.
   addStep(tr("Data"), m_dataStep);
+  addStep(tr("Initial pose"), new LandmarkStepWidget(m_document, this));
+  addStep(tr("ROIs"), new RoiStepWidget(m_document, this));
+  addStep(tr("Register"), new RegisterStepWidget(m_document, this));
+  addStep(tr("Review"), new ReviewStepWidget(m_document, this));
 
   buildMenus();
   updateTitle();

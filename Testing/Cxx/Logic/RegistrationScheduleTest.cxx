@@ -114,3 +114,29 @@ TEST(RegistrationSchedule, AblationTurnsOneTechniqueOffAtATime) {
   EXPECT_EQ(paper.withAblation(rois).stages[2].pixels.kind, fct::PixelSetKind::WholeImage);
   EXPECT_EQ(paper.withAblation(rois).stages[2].level, 0);
 }
+
+TEST(RegistrationSchedule, RoiPixelsReplaceEveryRoiStagesWindowAndFractionOnly) {
+  const auto fast = RegistrationSchedule::builtin("fast").value();
+  auto same = fast.withRoiPixels(7, 0.15);
+  ASSERT_TRUE(same.ok()) << same.error();
+  EXPECT_EQ(same.value().stages[0].pixels.kind, fct::PixelSetKind::WholeImage);
+  auto tuned = fast.withRoiPixels(9, 0.2);
+  ASSERT_TRUE(tuned.ok()) << tuned.error();
+  ASSERT_EQ(tuned.value().stages.size(), fast.stages.size());
+  EXPECT_EQ(tuned.value().stages[0].pixels.windowSize, fast.stages[0].pixels.windowSize) << "whole-image stage kept";
+  for (std::size_t i = 1; i < fast.stages.size(); ++i) {
+    EXPECT_EQ(tuned.value().stages[i].pixels.windowSize, 9);
+    EXPECT_DOUBLE_EQ(tuned.value().stages[i].pixels.targetFraction, 0.2);
+    EXPECT_EQ(tuned.value().stages[i].level, fast.stages[i].level);
+  }
+}
+
+TEST(RegistrationSchedule, RoiPixelsRejectABadWindowOrFraction) {
+  const auto fast = RegistrationSchedule::builtin("fast").value();
+  auto window = fast.withRoiPixels(1, 0.1);
+  ASSERT_FALSE(window.ok());
+  EXPECT_NE(window.error().find("2 to 64"), std::string::npos);
+  auto fraction = fast.withRoiPixels(7, 0.0);
+  ASSERT_FALSE(fraction.ok());
+  EXPECT_NE(fraction.error().find("(0, 1]"), std::string::npos);
+}

@@ -1,0 +1,104 @@
+// RegisterStepWidget: a fast registration run on its worker thread ends near the truth and lands in the document;
+// cancelling a run mid-way keeps the best pose so far, marked cancelled, and the widget runs again afterwards; a
+// missing initial pose is refused with a message.
+#include <gtest/gtest.h>
+
+#include "PoseOffset.h"
+#include "RegisterStepWidget.h"
+#include "StepTestSession.h"
+
+namespace {
+
+void setStartPose(fct::test::StepTestSession& session, double distance_mm) {
+  auto start = fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, distance_mm, 3);
+  ASSERT_TRUE(start.ok()) << start.error();
+  session.document.setInitialPose(start.value(), QStringLiteral("test start"));
+}
+
+}  // namespace
+
+TEST(RegisterStepWidget, FastRunOnItsThreadEndsWithinOneMillimetre) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  setStartPose(session, 5.0);
+  fct::RegisterStepWidget step(&session.document);
+  ASSERT_TRUE(step.run()) << step.message().toStdString();
+  EXPECT_TRUE(step.isRunning());
+  EXPECT_FALSE(step.run()) << "one run at a time";
+  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000)) << "the run ends";
+  ASSERT_TRUE(session.document.result().has_value()) << step.message().toStdString();
+  const fct::RegistrationResult& result = *session.document.result();
+  EXPECT_FALSE(result.cancelled);
+  EXPECT_EQ(result.stages.size(), 4u) << "the fast preset's stages";
+  EXPECT_GT(step.lastProgress().drrs, 0) << "progress reached the widget";
+  const double error_mm = session.surfaceError_mm(result.T_world_from_ct);
+  std::printf("fast registration from 5 mm via the Register step: %.3f mm, %ld DRRs\n", error_mm, result.totalDrrs);
+  EXPECT_LT(error_mm, 1.0);
+  EXPECT_NE(step.logText().indexOf(QStringLiteral("Registered")), -1);
+}
+
+TEST(RegisterStepWidget, CancelMidRunKeepsTheBestPoseMarkedAndTheWidgetRunsAgain) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  setStartPose(session, 8.0);
+  const Eigen::Isometry3d start = *session.document.initialPose();
+  fct::StudioRegistrationOptions options = session.document.registrationOptions();
+  options.preset = "paper";
+  session.document.setRegistrationOptions(options);
+  fct::RegisterStepWidget step(&session.document);
+  ASSERT_TRUE(step.run()) << step.message().toStdString();
+  ASSERT_TRUE(fct::test::waitUntil([&] { return step.lastProgress().drrs > 0; }, 60000)) << "progress arrives";
+  step.cancel();
+  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 60000)) << "cancelling ends the run";
+  ASSERT_TRUE(session.document.result().has_value());
+  const fct::RegistrationResult& cancelled = *session.document.result();
+  EXPECT_TRUE(cancelled.cancelled);
+  EXPECT_LE(session.surfaceError_mm(cancelled.T_world_from_ct), session.surfaceError_mm(start) + 1e-6)
+      << "the best pose so far is never worse than the start";
+  EXPECT_NE(step.message().indexOf(QStringLiteral("Cancelled")), -1) << step.message().toStdString();
+
+  options.preset = "fast";
+  session.document.setRegistrationOptions(options);
+  ASSERT_TRUE(step.run()) << step.message().toStdString();
+  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000));
+  ASSERT_TRUE(session.document.result().has_value());
+  EXPECT_FALSE(session.document.result()->cancelled);
+}
+
+TEST(RegisterStepWidget, RefusesToRunWithoutAnInitialPoseOrWithABadPreset) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  step.setActive(true);
+  EXPECT_NE(step.message().indexOf(QStringLiteral("No initial pose")), -1) << step.message().toStdString();
+  EXPECT_FALSE(step.run());
+  EXPECT_NE(step.message().indexOf(QStringLiteral("initial pose")), -1) << step.message().toStdString();
+  EXPECT_FALSE(step.isRunning());
+  setStartPose(session, 3.0);
+  step.setActive(true);
+  EXPECT_NE(step.message().indexOf(QStringLiteral("Ready: initial pose from test start")), -1)
+      << step.message().toStdString();
+  fct::StudioRegistrationOptions options = session.document.registrationOptions();
+  options.preset = "/nonexistent/preset.json";
+  session.document.setRegistrationOptions(options);
+  EXPECT_FALSE(step.run());
+  EXPECT_NE(step.message().indexOf(QStringLiteral("Preset")), -1) << step.message().toStdString();
+  EXPECT_FALSE(session.document.result().has_value());
+}
+
+TEST(RegisterStepWidget, DestroyingTheWidgetDuringARunCancelsItCleanly) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  setStartPose(session, 5.0);
+  auto step = std::make_unique<fct::RegisterStepWidget>(&session.document);
+  ASSERT_TRUE(step->run());
+  step.reset();
+  EXPECT_FALSE(session.document.result().has_value()) << "a run cut short by closing stores nothing";
+}
+
+TEST(RegisterStepWidget, AResultOfViewsReplacedDuringTheRunIsNotKept) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  setStartPose(session, 5.0);
+  fct::RegisterStepWidget step(&session.document);
+  ASSERT_TRUE(step.run()) << step.message().toStdString();
+  session.document.setViews(session.document.views());
+  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000));
+  EXPECT_FALSE(session.document.result().has_value());
+  EXPECT_NE(step.message().indexOf(QStringLiteral("changed during the run")), -1) << step.message().toStdString();
+}

@@ -1,0 +1,101 @@
+// ReviewStepWidget: contours at both poses over every X-ray, the DRR blend and checkerboard, flicker, sTRE with a
+// truth, the verdict, and the exports (.tfm and JSON read back equal; screenshot PNG readable).
+#include <gtest/gtest.h>
+
+#include <QImage>
+
+#include "ItkTransformFile.h"
+#include "PoseFile.h"
+#include "PoseOffset.h"
+#include "ReviewStepWidget.h"
+#include "StepTestSession.h"
+#include "TestSupport.h"
+
+namespace {
+
+/// A result ending at `finalPose` from a start 4 mm away.
+fct::RegistrationResult resultAt(const fct::test::StepTestSession& session, const Eigen::Isometry3d& finalPose) {
+  fct::RegistrationResult result;
+  result.T_initial = fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, 4.0, 5).value();
+  result.T_world_from_ct = finalPose;
+  return result;
+}
+
+}  // namespace
+
+TEST(ReviewStepWidget, DrawsBothOutlinesAndTheDrrAndShowsTheSurfaceError) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  session.document.setResult(resultAt(session, session.T_truth));
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  ASSERT_TRUE(step.finalSurfaceTre_mm().has_value()) << step.message().toStdString();
+  EXPECT_NEAR(*step.finalSurfaceTre_mm(), 0.0, 1e-9);
+  for (fct::XrayViewWidget* view : session.xrayViews) {
+    EXPECT_TRUE(view->isLayerVisible(fct::ReviewStepWidget::kInitialLayer));
+    EXPECT_TRUE(view->isLayerVisible(fct::ReviewStepWidget::kFinalLayer));
+    EXPECT_FALSE(view->hasLayer(fct::ReviewStepWidget::kDrrLayer)) << "DRR off by default";
+  }
+  step.setShowInitial(false);
+  EXPECT_FALSE(session.xrayViews[0]->isLayerVisible(fct::ReviewStepWidget::kInitialLayer));
+  EXPECT_TRUE(session.xrayViews[0]->isLayerVisible(fct::ReviewStepWidget::kFinalLayer));
+
+  step.setDrrMode(fct::ReviewStepWidget::DrrMode::Checkerboard);
+  EXPECT_TRUE(session.xrayViews[1]->isLayerVisible(fct::ReviewStepWidget::kDrrLayer));
+  step.setFlicker(true);
+  EXPECT_TRUE(step.isFlickering());
+  const bool shown = session.xrayViews[1]->isLayerVisible(fct::ReviewStepWidget::kDrrLayer);
+  QTest::qWait(fct::ReviewStepWidget::kFlickerInterval_ms + 200);
+  EXPECT_NE(session.xrayViews[1]->isLayerVisible(fct::ReviewStepWidget::kDrrLayer), shown) << "the DRR flickered";
+  step.setActive(false);
+  EXPECT_FALSE(step.isFlickering()) << "an inactive step does not flicker";
+  EXPECT_FALSE(session.xrayViews[1]->isLayerVisible(fct::ReviewStepWidget::kFinalLayer));
+}
+
+TEST(ReviewStepWidget, AcceptRejectAndExportsReadBack) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  const Eigen::Isometry3d finalPose =
+      fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, 0.5, 9).value();
+  session.document.setResult(resultAt(session, finalPose));
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  EXPECT_NEAR(*step.finalSurfaceTre_mm(), 0.5, 1e-3);
+  step.acceptResult();
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Accepted);
+  step.rejectResult();
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Rejected);
+
+  const auto dir = fct::test::scratchDir();
+  ASSERT_TRUE(step.exportPose(QString::fromStdString((dir / "pose.tfm").string()))) << step.message().toStdString();
+  auto tfm = fct::ItkTransformFile::read(dir / "pose.tfm");
+  ASSERT_TRUE(tfm.ok()) << tfm.error();
+  EXPECT_TRUE(tfm.value().isApprox(finalPose, 1e-9));
+  ASSERT_TRUE(step.exportPose(QString::fromStdString((dir / "pose.json").string()))) << step.message().toStdString();
+  auto json = fct::PoseFile::read(dir / "pose.json");
+  ASSERT_TRUE(json.ok()) << json.error();
+  EXPECT_TRUE(json.value().isApprox(finalPose, 1e-9));
+
+  const QString shot = QString::fromStdString((dir / "review.png").string());
+  ASSERT_TRUE(step.saveScreenshot(shot)) << step.message().toStdString();
+  const QImage image(shot);
+  EXPECT_FALSE(image.isNull());
+  int viewsWidth = 0;
+  for (const fct::XrayViewWidget* view : session.xrayViews) viewsWidth += view->width();
+  EXPECT_EQ(image.width(), viewsWidth) << "the X-ray views side by side";
+  EXPECT_FALSE(step.saveScreenshot(QString::fromStdString((dir / "missing" / "x.png").string())));
+  EXPECT_NE(step.message().indexOf(QStringLiteral("Cannot write")), -1);
+}
+
+TEST(ReviewStepWidget, WithoutAResultExportIsRefusedWithAMessage) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  const auto dir = fct::test::scratchDir();
+  EXPECT_FALSE(step.exportPose(QString::fromStdString((dir / "pose.tfm").string())));
+  EXPECT_NE(step.message().indexOf(QStringLiteral("No registration result")), -1) << step.message().toStdString();
+  EXPECT_FALSE(std::filesystem::exists(dir / "pose.tfm"));
+  step.acceptResult();
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided);
+}

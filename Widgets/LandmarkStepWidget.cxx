@@ -1,0 +1,473 @@
+#include "LandmarkStepWidget.h"
+
+#include <QFileDialog>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QPushButton>
+#include <QTableWidget>
+#include <QVBoxLayout>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "BoneSurface.h"
+#include "LandmarkFile.h"
+#include "SetupPose.h"
+#include "SliceViewWidget.h"
+#include "StudioDocument.h"
+#include "XrayViewWidget.h"
+
+namespace fct {
+
+namespace {
+
+enum Column { kName, kCt, kViews, kResidualPx, kResidualMm, kColumnCount };
+
+const QColor kClickColour(255, 220, 0);
+const QColor kSelectedColour(0, 220, 255);
+const QColor kProjectedColour(255, 60, 200);
+
+std::map<std::string, Camera> camerasOf(const StudioDocument& document) {
+  std::map<std::string, Camera> cameras;
+  for (const RegistrationView& view : document.views()) cameras.emplace(view.name, view.camera);
+  return cameras;
+}
+
+bool nameInUse(const Landmarks& landmarks, const std::string& name) {
+  const auto sameName = [&name](const auto& landmark) { return landmark.name == name; };
+  if (std::any_of(landmarks.ct.begin(), landmarks.ct.end(), sameName)) return true;
+  return std::any_of(landmarks.imageByView.begin(), landmarks.imageByView.end(), [&](const auto& entry) {
+    return std::any_of(entry.second.begin(), entry.second.end(), sameName);
+  });
+}
+
+QTableWidgetItem* readOnlyItem(const QString& text) {
+  auto* item = new QTableWidgetItem(text);
+  item->setFlags(item->flags() & ~Qt::ItemIsEditable);
+  return item;
+}
+
+}  // namespace
+
+LandmarkStepWidget::LandmarkStepWidget(StudioDocument* document, QWidget* parent)
+    : QWidget(parent), m_document(document) {
+  auto* layout = new QVBoxLayout(this);
+  auto* help = new QLabel(tr("Click a point in a CT slice view to add a landmark, then click its partner in one or more "
+                             "X-ray views (drag to move it). At least 4 landmarks, not on one line."),
+                          this);
+  help->setWordWrap(true);
+  layout->addWidget(help);
+
+  m_table = new QTableWidget(0, kColumnCount, this);
+  m_table->setHorizontalHeaderLabels({tr("Name"), tr("CT (LPS mm)"), tr("X-ray views"), tr("Residual (px)"),
+                                      tr("Residual (mm)")});
+  m_table->setSelectionBehavior(QAbstractItemView::SelectRows);
+  m_table->setSelectionMode(QAbstractItemView::SingleSelection);
+  m_table->horizontalHeader()->setStretchLastSection(true);
+  m_table->verticalHeader()->setVisible(false);
+  layout->addWidget(m_table, 1);
+
+  auto* editRow = new QHBoxLayout();
+  m_deleteButton = new QPushButton(tr("Delete landmark"), this);
+  auto* loadButton = new QPushButton(tr("Load…"), this);
+  auto* saveButton = new QPushButton(tr("Save…"), this);
+  editRow->addWidget(m_deleteButton);
+  editRow->addStretch(1);
+  editRow->addWidget(loadButton);
+  editRow->addWidget(saveButton);
+  layout->addLayout(editRow);
+
+  auto* poseRow = new QHBoxLayout();
+  m_computeButton = new QPushButton(tr("Compute pose"), this);
+  auto* presetButton = new QPushButton(tr("Supine AP preset"), this);
+  presetButton->setToolTip(tr("Patient as in the CT, bone centre at the C-arm isocentre (no landmarks needed)"));
+  poseRow->addWidget(m_computeButton);
+  poseRow->addWidget(presetButton);
+  layout->addLayout(poseRow);
+
+  m_message = new QLabel(this);
+  m_message->setWordWrap(true);
+  m_message->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(m_message);
+
+  connect(m_table, &QTableWidget::currentCellChanged, this, [this](int row, int, int, int) {
+    if (m_refreshing) return;
+    m_selected = row >= 0 && m_table->item(row, kName) ? m_table->item(row, kName)->text() : QString();
+    updateLayers();
+  });
+  connect(m_table, &QTableWidget::cellChanged, this, &LandmarkStepWidget::onItemChanged);
+  connect(m_deleteButton, &QPushButton::clicked, this, [this] { deleteLandmark(m_selected); });
+  connect(loadButton, &QPushButton::clicked, this, &LandmarkStepWidget::loadWithDialog);
+  connect(saveButton, &QPushButton::clicked, this, &LandmarkStepWidget::saveWithDialog);
+  connect(m_computeButton, &QPushButton::clicked, this, &LandmarkStepWidget::computePose);
+  connect(presetButton, &QPushButton::clicked, this, &LandmarkStepWidget::applySetupPose);
+  // A pose estimate belongs to the landmarks and cameras it came from.
+  for (auto signal : {&StudioDocument::landmarksChanged, &StudioDocument::viewsChanged}) {
+    connect(m_document, signal, this, [this] {
+      m_estimate.reset();
+      refresh();
+    });
+  }
+  refresh();
+}
+
+void LandmarkStepWidget::attachViews(std::vector<XrayViewWidget*> xrayViews, std::array<SliceViewWidget*, 3> sliceViews) {
+  const bool wasActive = m_active;
+  setActive(false);
+  m_xrayViews = std::move(xrayViews);
+  m_sliceViews = sliceViews;
+  setActive(wasActive);
+}
+
+void LandmarkStepWidget::setActive(bool active) {
+  for (const QMetaObject::Connection& connection : m_viewConnections) disconnect(connection);
+  m_viewConnections.clear();
+  m_active = active;
+  if (active) {
+    for (SliceViewWidget* view : m_sliceViews) {
+      if (!view) continue;
+      m_viewConnections.push_back(
+          connect(view, &SliceViewWidget::pointClicked, this, &LandmarkStepWidget::addCtLandmark));
+    }
+    for (std::size_t v = 0; v < m_xrayViews.size(); ++v) {
+      const int viewIndex = static_cast<int>(v);
+      m_viewConnections.push_back(connect(m_xrayViews[v], &XrayViewWidget::pixelClicked, this,
+                                          [this, viewIndex](const Eigen::Vector2d& uv_px) {
+                                            setImagePoint(viewIndex, uv_px);
+                                          }));
+      m_viewConnections.push_back(
+          connect(m_xrayViews[v], &XrayViewWidget::pointDragged, this,
+                  [this, viewIndex](const QString& layer, int index, const Eigen::Vector2d& uv_px) {
+                    onPointDragged(viewIndex, layer, index, uv_px);
+                  }));
+    }
+  }
+  updateLayers();
+}
+
+QString LandmarkStepWidget::selectedLandmark() const { return m_selected; }
+
+QString LandmarkStepWidget::message() const { return m_message->text(); }
+
+void LandmarkStepWidget::showMessage(const QString& text, bool error) {
+  m_message->setStyleSheet(error ? QStringLiteral("color: #c0392b;") : QString());
+  m_message->setText(text);
+}
+
+void LandmarkStepWidget::addCtLandmark(const Eigen::Vector3d& p_ct_mm) {
+  if (!m_document->ct()) {
+    showMessage(tr("No CT loaded: open a CT in the Data step before placing landmarks."), true);
+    return;
+  }
+  Landmarks landmarks = m_document->landmarks();
+  std::string name;
+  for (std::size_t n = landmarks.ct.size() + 1;; ++n) {
+    name = fmt::format("L{}", n);
+    if (!nameInUse(landmarks, name)) break;
+  }
+  landmarks.ct.push_back(CtLandmark{name, p_ct_mm});
+  m_selected = QString::fromStdString(name);
+  m_document->setLandmarks(std::move(landmarks));
+  showMessage(tr("Added %1 at (%2, %3, %4) mm; now click its partner in the X-ray views.")
+                  .arg(m_selected)
+                  .arg(p_ct_mm.x(), 0, 'f', 1)
+                  .arg(p_ct_mm.y(), 0, 'f', 1)
+                  .arg(p_ct_mm.z(), 0, 'f', 1),
+              false);
+}
+
+void LandmarkStepWidget::setImagePoint(int viewIndex, const Eigen::Vector2d& uv_px) {
+  const auto& views = m_document->views();
+  if (viewIndex < 0 || viewIndex >= static_cast<int>(views.size())) {
+    showMessage(tr("X-ray view %1 does not exist (%2 views are loaded).").arg(viewIndex + 1).arg(views.size()), true);
+    return;
+  }
+  if (m_selected.isEmpty()) {
+    showMessage(tr("Select a landmark in the table (or add one in a CT slice view) before clicking in an X-ray view."),
+                true);
+    return;
+  }
+  Landmarks landmarks = m_document->landmarks();
+  const std::string name = m_selected.toStdString();
+  std::vector<ImageLandmark>& points = landmarks.imageByView[views[static_cast<std::size_t>(viewIndex)].name];
+  auto found = std::find_if(points.begin(), points.end(), [&](const ImageLandmark& p) { return p.name == name; });
+  if (found != points.end()) {
+    found->uv_px = uv_px;
+  } else {
+    points.push_back(ImageLandmark{name, uv_px});
+  }
+  m_document->setLandmarks(std::move(landmarks));
+  showMessage(tr("%1 placed in view '%2' at (%3, %4) px.")
+                  .arg(m_selected, QString::fromStdString(views[static_cast<std::size_t>(viewIndex)].name))
+                  .arg(uv_px.x(), 0, 'f', 1)
+                  .arg(uv_px.y(), 0, 'f', 1),
+              false);
+}
+
+void LandmarkStepWidget::selectLandmark(const QString& name) {
+  m_selected = rowOf(name) >= 0 ? name : QString();
+  refresh();
+}
+
+bool LandmarkStepWidget::renameLandmark(const QString& oldName, const QString& newName) {
+  const std::string from = oldName.toStdString();
+  const std::string to = newName.trimmed().toStdString();
+  Landmarks landmarks = m_document->landmarks();
+  if (to.empty() || (to != from && nameInUse(landmarks, to))) {
+    showMessage(to.empty() ? tr("A landmark name cannot be empty.")
+                           : tr("The name '%1' is already used; choose another.").arg(QString::fromStdString(to)),
+                true);
+    refresh();
+    return false;
+  }
+  for (CtLandmark& landmark : landmarks.ct) {
+    if (landmark.name == from) landmark.name = to;
+  }
+  for (auto& [view, points] : landmarks.imageByView) {
+    for (ImageLandmark& point : points) {
+      if (point.name == from) point.name = to;
+    }
+  }
+  if (m_selected == oldName) m_selected = QString::fromStdString(to);
+  m_document->setLandmarks(std::move(landmarks));
+  return true;
+}
+
+void LandmarkStepWidget::deleteLandmark(const QString& name) {
+  if (name.isEmpty()) {
+    showMessage(tr("Select the landmark to delete in the table."), true);
+    return;
+  }
+  const std::string target = name.toStdString();
+  Landmarks landmarks = m_document->landmarks();
+  const auto named = [&target](const auto& landmark) { return landmark.name == target; };
+  std::erase_if(landmarks.ct, named);
+  for (auto& [view, points] : landmarks.imageByView) std::erase_if(points, named);
+  std::erase_if(landmarks.imageByView, [](const auto& entry) { return entry.second.empty(); });
+  if (m_selected == name) m_selected.clear();
+  m_document->setLandmarks(std::move(landmarks));
+  showMessage(tr("Deleted %1.").arg(name), false);
+}
+
+bool LandmarkStepWidget::computePose() {
+  if (m_document->views().empty()) {
+    showMessage(tr("No X-ray views loaded: open a view file in the Data step first."), true);
+    return false;
+  }
+  auto estimate = LandmarkPoseEstimator::fromReprojection(m_document->landmarks(), camerasOf(*m_document));
+  if (!estimate) {
+    showMessage(tr("Cannot compute the pose: %1").arg(QString::fromStdString(estimate.error())), true);
+    return false;
+  }
+  m_estimate = std::move(estimate).value();
+  const QString source = tr("landmarks (%1 pairs, %2)")
+                             .arg(m_estimate->residuals.size())
+                             .arg(QString::fromStdString(m_estimate->method));
+  m_document->setInitialPose(m_estimate->T_world_from_ct, source);
+  QString text = tr("Initial pose from %1 landmarks (%2): RMS reprojection %3 px")
+                     .arg(m_estimate->residuals.size())
+                     .arg(QString::fromStdString(m_estimate->method))
+                     .arg(m_estimate->rmsReprojection_px, 0, 'f', 2);
+  if (std::isfinite(m_estimate->rms3d_mm)) text += tr(", RMS 3-D %1 mm").arg(m_estimate->rms3d_mm, 0, 'f', 2);
+  showMessage(text + QLatin1Char('.'), false);
+  refresh();
+  return true;
+}
+
+bool LandmarkStepWidget::applySetupPose() {
+  const auto& ct = m_document->ct();
+  if (!ct) {
+    showMessage(tr("No CT loaded: open a CT in the Data step first."), true);
+    return false;
+  }
+  std::vector<Camera> cameras;
+  for (const RegistrationView& view : m_document->views()) cameras.push_back(view.camera);
+  auto bone = BoneSurface::extract(*ct);
+  const Eigen::Vector3d centre_ct_mm = bone ? bone.value().centroid_ct_mm() : ct->centre_lps_mm();
+  auto pose = SetupPose::supineAtIsocentre(centre_ct_mm, cameras);
+  if (!pose) {
+    showMessage(tr("Cannot set the supine AP pose: %1").arg(QString::fromStdString(pose.error())), true);
+    return false;
+  }
+  m_estimate.reset();
+  m_document->setInitialPose(pose.value(), tr("preset supine AP"));
+  showMessage(tr("Initial pose: supine AP, %1 at the C-arm isocentre.")
+                  .arg(bone ? tr("bone centre") : tr("CT centre (no bone found)")),
+              false);
+  refresh();
+  return true;
+}
+
+bool LandmarkStepWidget::loadLandmarks(const QString& ctPath, const QString& imagePath) {
+  auto ct = LandmarkFile::readCt(ctPath.toStdString());
+  if (!ct) {
+    showMessage(tr("Cannot load the CT landmarks: %1").arg(QString::fromStdString(ct.error())), true);
+    return false;
+  }
+  Landmarks landmarks;
+  landmarks.ct = std::move(ct).value();
+  if (!imagePath.isEmpty()) {
+    auto image = LandmarkFile::readImage(imagePath.toStdString());
+    if (!image) {
+      showMessage(tr("Cannot load the X-ray landmarks: %1").arg(QString::fromStdString(image.error())), true);
+      return false;
+    }
+    landmarks.imageByView = std::move(image).value();
+  }
+  m_selected.clear();
+  const std::size_t count = landmarks.ct.size();
+  m_document->setLandmarks(std::move(landmarks));
+  showMessage(tr("Loaded %1 CT landmarks.").arg(count), false);
+  return true;
+}
+
+bool LandmarkStepWidget::saveLandmarks(const QString& ctPath, const QString& imagePath) {
+  const Landmarks& landmarks = m_document->landmarks();
+  if (Status written = LandmarkFile::writeCt(landmarks.ct, ctPath.toStdString()); !written) {
+    showMessage(tr("Cannot save the CT landmarks: %1").arg(QString::fromStdString(written.error())), true);
+    return false;
+  }
+  if (!imagePath.isEmpty()) {
+    if (Status written = LandmarkFile::writeImage(landmarks.imageByView, imagePath.toStdString()); !written) {
+      showMessage(tr("Cannot save the X-ray landmarks: %1").arg(QString::fromStdString(written.error())), true);
+      return false;
+    }
+  }
+  showMessage(tr("Saved %1 landmarks to %2.").arg(landmarks.ct.size()).arg(ctPath), false);
+  return true;
+}
+
+int LandmarkStepWidget::rowOf(const QString& name) const {
+  const auto& ct = m_document->landmarks().ct;
+  for (std::size_t i = 0; i < ct.size(); ++i) {
+    if (QString::fromStdString(ct[i].name) == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void LandmarkStepWidget::refresh() {
+  m_refreshing = true;
+  const Landmarks& landmarks = m_document->landmarks();
+  if (rowOf(m_selected) < 0) m_selected.clear();
+  m_table->setRowCount(static_cast<int>(landmarks.ct.size()));
+  for (std::size_t i = 0; i < landmarks.ct.size(); ++i) {
+    const CtLandmark& landmark = landmarks.ct[i];
+    const int row = static_cast<int>(i);
+    m_table->setItem(row, kName, new QTableWidgetItem(QString::fromStdString(landmark.name)));
+    m_table->setItem(row, kCt, readOnlyItem(QStringLiteral("%1, %2, %3")
+                                                .arg(landmark.p_ct_mm.x(), 0, 'f', 1)
+                                                .arg(landmark.p_ct_mm.y(), 0, 'f', 1)
+                                                .arg(landmark.p_ct_mm.z(), 0, 'f', 1)));
+    QStringList views;
+    for (const auto& [view, points] : landmarks.imageByView) {
+      const bool has = std::any_of(points.begin(), points.end(),
+                                   [&](const ImageLandmark& p) { return p.name == landmark.name; });
+      if (has) views << QString::fromStdString(view);
+    }
+    m_table->setItem(row, kViews, readOnlyItem(views.isEmpty() ? tr("none yet") : views.join(QStringLiteral(", "))));
+    QString residualPx = QStringLiteral("—");
+    QString residualMm = QStringLiteral("—");
+    if (m_estimate) {
+      for (const LandmarkResidual& residual : m_estimate->residuals) {
+        if (residual.name != landmark.name) continue;
+        double worst_px = 0.0;
+        for (const auto& [view, px] : residual.reprojection_px) worst_px = std::max(worst_px, px);
+        residualPx = QString::number(worst_px, 'f', 2);
+        if (std::isfinite(residual.distance_mm)) residualMm = QString::number(residual.distance_mm, 'f', 2);
+      }
+    }
+    m_table->setItem(row, kResidualPx, readOnlyItem(residualPx));
+    m_table->setItem(row, kResidualMm, readOnlyItem(residualMm));
+  }
+  const int selectedRow = rowOf(m_selected);
+  if (selectedRow >= 0) {
+    m_table->setCurrentCell(selectedRow, kName);
+  } else {
+    m_table->clearSelection();
+  }
+  m_deleteButton->setEnabled(!landmarks.ct.empty());
+  m_refreshing = false;
+  updateLayers();
+}
+
+void LandmarkStepWidget::updateLayers() {
+  const Landmarks& landmarks = m_document->landmarks();
+  const auto& views = m_document->views();
+  m_clickLayerNames.assign(m_xrayViews.size(), {});
+  for (std::size_t v = 0; v < m_xrayViews.size(); ++v) {
+    XrayViewWidget* xrayView = m_xrayViews[v];
+    if (!m_active || v >= views.size()) {
+      xrayView->setLayerVisible(kClickLayer, false);
+      xrayView->setLayerVisible(kProjectedLayer, false);
+      continue;
+    }
+    std::vector<OverlayPoint> clicks;
+    if (auto found = landmarks.imageByView.find(views[v].name); found != landmarks.imageByView.end()) {
+      for (const ImageLandmark& point : found->second) {
+        const QString name = QString::fromStdString(point.name);
+        clicks.push_back(OverlayPoint{point.uv_px, name, name == m_selected ? kSelectedColour : kClickColour});
+        m_clickLayerNames[v].push_back(name);
+      }
+    }
+    xrayView->setPointLayer(kClickLayer, std::move(clicks), true);
+    std::vector<OverlayPoint> projected;
+    if (m_estimate) {
+      for (const CtLandmark& landmark : landmarks.ct) {
+        bool inFront = false;
+        const Eigen::Vector2d uv_px = views[v].camera.project(m_estimate->T_world_from_ct * landmark.p_ct_mm, &inFront);
+        if (inFront) projected.push_back(OverlayPoint{uv_px, QString::fromStdString(landmark.name) + "'", kProjectedColour});
+      }
+    }
+    xrayView->setPointLayer(kProjectedLayer, std::move(projected));
+  }
+  for (SliceViewWidget* sliceView : m_sliceViews) {
+    if (!sliceView) continue;
+    std::vector<SlicePoint> points;
+    if (m_active) {
+      for (const CtLandmark& landmark : landmarks.ct) {
+        const QString name = QString::fromStdString(landmark.name);
+        points.push_back(SlicePoint{landmark.p_ct_mm, name, name == m_selected ? kSelectedColour : kClickColour});
+      }
+    }
+    sliceView->setCtPointLayer(kClickLayer, std::move(points));
+  }
+}
+
+void LandmarkStepWidget::onPointDragged(int viewIndex, const QString& layer, int index, const Eigen::Vector2d& uv_px) {
+  if (layer != kClickLayer || viewIndex < 0 || viewIndex >= static_cast<int>(m_clickLayerNames.size())) return;
+  const auto& names = m_clickLayerNames[static_cast<std::size_t>(viewIndex)];
+  if (index < 0 || index >= static_cast<int>(names.size())) return;
+  m_selected = names[static_cast<std::size_t>(index)];
+  setImagePoint(viewIndex, uv_px);
+}
+
+void LandmarkStepWidget::onItemChanged(int row, int column) {
+  if (m_refreshing || column != kName) return;
+  const auto& ct = m_document->landmarks().ct;
+  if (row < 0 || row >= static_cast<int>(ct.size())) return;
+  renameLandmark(QString::fromStdString(ct[static_cast<std::size_t>(row)].name), m_table->item(row, kName)->text());
+}
+
+void LandmarkStepWidget::loadWithDialog() {
+  const QString ctPath = QFileDialog::getOpenFileName(this, tr("Open CT landmarks"), QString(),
+                                                      tr("Slicer markups (*.mrk.json *.json)"));
+  if (ctPath.isEmpty()) return;
+  const QString imagePath = QFileDialog::getOpenFileName(this, tr("Open X-ray landmarks (cancel for none)"), QString(),
+                                                         tr("X-ray landmarks (*.json)"));
+  loadLandmarks(ctPath, imagePath);
+}
+
+void LandmarkStepWidget::saveWithDialog() {
+  const QString ctPath = QFileDialog::getSaveFileName(this, tr("Save CT landmarks"), QStringLiteral("landmarks.mrk.json"),
+                                                      tr("Slicer markups (*.mrk.json)"));
+  if (ctPath.isEmpty()) return;
+  const QString imagePath = QFileDialog::getSaveFileName(this, tr("Save X-ray landmarks (cancel for none)"),
+                                                         QStringLiteral("landmarks_xray.json"),
+                                                         tr("X-ray landmarks (*.json)"));
+  saveLandmarks(ctPath, imagePath);
+}
+
+}  // namespace fct

@@ -1,0 +1,305 @@
+#include "RegisterStepWidget.h"
+
+#include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QPlainTextEdit>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSpinBox>
+#include <QThread>
+#include <QVBoxLayout>
+
+#include <fmt/format.h>
+
+#include "RegistrationWorker.h"
+#include "StudioDocument.h"
+
+namespace fct {
+
+RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent)
+    : QWidget(parent), m_document(document) {
+  qRegisterMetaType<fct::RegistrationProgress>();
+  qRegisterMetaType<fct::RegistrationResult>();
+  auto* layout = new QVBoxLayout(this);
+
+  auto* optionsBox = new QGroupBox(tr("Options"), this);
+  auto* form = new QFormLayout(optionsBox);
+  m_presetCombo = new QComboBox(optionsBox);
+  for (const std::string& name : RegistrationSchedule::builtinNames()) m_presetCombo->addItem(QString::fromStdString(name));
+  m_presetCombo->setToolTip(tr("fast: a small genetic search, then VLNC on ROIs at 1:16, 1:4, 1:1; paper: the paper's "
+                               "three stages with n = 4 genetic guesses"));
+  form->addRow(tr("Preset"), m_presetCombo);
+  m_seedSpin = new QSpinBox(optionsBox);
+  m_seedSpin->setRange(0, 1000000);
+  form->addRow(tr("Random seed"), m_seedSpin);
+  m_methodCombo = new QComboBox(optionsBox);
+  m_methodCombo->addItems({QStringLiteral("siddon"), QStringLiteral("raycast")});
+  form->addRow(tr("DRR method"), m_methodCombo);
+  layout->addWidget(optionsBox);
+
+  auto* ablationBox = new QGroupBox(tr("Switch off (ablation)"), this);
+  auto* ablationLayout = new QVBoxLayout(ablationBox);
+  m_noRoisCheck = new QCheckBox(tr("Dynamic ROIs (compare every pixel)"), ablationBox);
+  m_noPyramidCheck = new QCheckBox(tr("Pyramid (every stage at full resolution)"), ablationBox);
+  m_nccOnlyCheck = new QCheckBox(tr("VLNC (NCC in every stage)"), ablationBox);
+  m_localOnlyCheck = new QCheckBox(tr("Global search (local simplex only)"), ablationBox);
+  m_cmaesCheck = new QCheckBox(tr("Genetic search (CMA-ES instead)"), ablationBox);
+  for (QCheckBox* check : {m_noRoisCheck, m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck, m_cmaesCheck}) {
+    ablationLayout->addWidget(check);
+  }
+  layout->addWidget(ablationBox);
+
+  auto* buttons = new QHBoxLayout();
+  m_runButton = new QPushButton(tr("Run"), this);
+  m_cancelButton = new QPushButton(tr("Cancel"), this);
+  m_cancelButton->setEnabled(false);
+  buttons->addWidget(m_runButton);
+  buttons->addWidget(m_cancelButton);
+  layout->addLayout(buttons);
+
+  m_progressBar = new QProgressBar(this);
+  m_progressBar->setRange(0, 1000);
+  m_progressBar->setValue(0);
+  m_progressBar->setTextVisible(false);
+  layout->addWidget(m_progressBar);
+  m_progressLabel = new QLabel(tr("Not started"), this);
+  layout->addWidget(m_progressLabel);
+  m_message = new QLabel(this);
+  m_message->setWordWrap(true);
+  m_message->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(m_message);
+  m_log = new QPlainTextEdit(this);
+  m_log->setReadOnly(true);
+  m_log->setMaximumBlockCount(2000);
+  layout->addWidget(m_log, 1);
+
+  connect(m_runButton, &QPushButton::clicked, this, &RegisterStepWidget::run);
+  connect(m_cancelButton, &QPushButton::clicked, this, &RegisterStepWidget::cancel);
+  connect(m_presetCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
+  connect(m_seedSpin, &QSpinBox::valueChanged, this, &RegisterStepWidget::pushOptions);
+  connect(m_methodCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
+  connect(m_document, &StudioDocument::registrationOptionsChanged, this, &RegisterStepWidget::syncControls);
+  for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged}) {
+    connect(m_document, signal, this, [this] {
+      if (m_thread) m_inputsChangedDuringRun = true;
+    });
+  }
+  syncControls();
+}
+
+RegisterStepWidget::~RegisterStepWidget() {
+  if (m_worker) m_worker->cancel();
+  endThread();
+}
+
+void RegisterStepWidget::attachViews(std::vector<XrayViewWidget*>, std::array<SliceViewWidget*, 3>) {}
+
+void RegisterStepWidget::setActive(bool active) {
+  if (!active || m_thread) return;
+  const RoiParameters& roi = m_document->roiParameters();
+  if (!m_document->initialPose()) {
+    showMessage(tr("No initial pose yet: set one in the Initial pose step (landmarks or the supine AP preset)."), true);
+    return;
+  }
+  showMessage(tr("Ready: initial pose from %1; ROIs of %2 px keeping %3 % of the pixels.")
+                  .arg(m_document->initialPoseSource().isEmpty() ? tr("the session") : m_document->initialPoseSource())
+                  .arg(roi.windowSize)
+                  .arg(100.0 * roi.targetFraction, 0, 'f', 1),
+              false);
+}
+
+RegistrationAblation RegisterStepWidget::ablation() const {
+  RegistrationAblation ablation;
+  ablation.noDynamicRois = m_noRoisCheck->isChecked();
+  ablation.noPyramid = m_noPyramidCheck->isChecked();
+  ablation.nccOnly = m_nccOnlyCheck->isChecked();
+  ablation.localOnly = m_localOnlyCheck->isChecked();
+  ablation.cmaesForGenetic = m_cmaesCheck->isChecked();
+  return ablation;
+}
+
+void RegisterStepWidget::setAblation(const RegistrationAblation& ablation) {
+  m_noRoisCheck->setChecked(ablation.noDynamicRois);
+  m_noPyramidCheck->setChecked(ablation.noPyramid);
+  m_nccOnlyCheck->setChecked(ablation.nccOnly);
+  m_localOnlyCheck->setChecked(ablation.localOnly);
+  m_cmaesCheck->setChecked(ablation.cmaesForGenetic);
+}
+
+QString RegisterStepWidget::message() const { return m_message->text(); }
+
+QString RegisterStepWidget::logText() const { return m_log->toPlainText(); }
+
+void RegisterStepWidget::showMessage(const QString& text, bool error) {
+  m_message->setStyleSheet(error ? QStringLiteral("color: #c0392b;") : QString());
+  m_message->setText(text);
+}
+
+void RegisterStepWidget::appendLog(const QString& line) { m_log->appendPlainText(line); }
+
+void RegisterStepWidget::syncControls() {
+  const StudioRegistrationOptions& options = m_document->registrationOptions();
+  const QSignalBlocker b1(m_presetCombo), b2(m_seedSpin), b3(m_methodCombo);
+  const QString preset = QString::fromStdString(options.preset);
+  if (m_presetCombo->findText(preset) < 0) m_presetCombo->addItem(preset);
+  m_presetCombo->setCurrentText(preset);
+  m_seedSpin->setValue(static_cast<int>(options.seed));
+  const QString method = QString::fromStdString(options.drrMethod);
+  if (m_methodCombo->findText(method) < 0) m_methodCombo->addItem(method);
+  m_methodCombo->setCurrentText(method);
+}
+
+void RegisterStepWidget::pushOptions() {
+  StudioRegistrationOptions options = m_document->registrationOptions();
+  options.preset = m_presetCombo->currentText().toStdString();
+  options.seed = static_cast<std::uint32_t>(m_seedSpin->value());
+  options.drrMethod = m_methodCombo->currentText().toStdString();
+  m_document->setRegistrationOptions(options);
+}
+
+bool RegisterStepWidget::run() {
+  if (m_thread) {
+    showMessage(tr("A registration is already running; cancel it first."), true);
+    return false;
+  }
+  const auto& initial = m_document->initialPose();
+  if (!initial) {
+    showMessage(tr("No initial pose: set one in the Initial pose step (landmarks or the supine AP preset)."), true);
+    return false;
+  }
+  const StudioRegistrationOptions& studioOptions = m_document->registrationOptions();
+  auto schedule = RegistrationSchedule::resolve(studioOptions.preset);
+  if (!schedule) {
+    showMessage(tr("Preset: %1").arg(QString::fromStdString(schedule.error())), true);
+    return false;
+  }
+  const RoiParameters& roi = m_document->roiParameters();
+  auto tuned = schedule.value().withRoiPixels(roi.windowSize, roi.targetFraction);
+  if (!tuned) {
+    showMessage(tr("ROI settings: %1; fix them in the ROIs step.").arg(QString::fromStdString(tuned.error())), true);
+    return false;
+  }
+  showMessage(tr("Preparing the case…"), false);
+  QApplication::setOverrideCursor(Qt::WaitCursor);
+  auto prepared = m_document->preparedCase();
+  QApplication::restoreOverrideCursor();
+  if (!prepared) {
+    showMessage(tr("Cannot register: %1").arg(QString::fromStdString(prepared.error())), true);
+    return false;
+  }
+  RegistrationOptions options;
+  options.schedule = std::move(tuned).value();
+  options.ablation = ablation();
+  options.seed = studioOptions.seed;
+
+  const auto ablations = options.ablation.activeNames();
+  appendLog(QString::fromStdString(fmt::format(
+      "Run: preset {}, seed {}, DRR {}, ROIs {} px keeping {:.1f} %, switched off: {}; initial pose: {}",
+      options.schedule.name, options.seed, studioOptions.drrMethod, roi.windowSize, 100.0 * roi.targetFraction,
+      ablations.empty() ? std::string("none") : fmt::format("{}", fmt::join(ablations, ", ")),
+      m_document->initialPoseSource().toStdString())));
+
+  m_lastProgress = RegistrationProgress{};
+  m_inputsChangedDuringRun = false;
+  m_worker = new RegistrationWorker(prepared.value(), *initial, std::move(options));
+  m_thread = new QThread(this);
+  m_worker->moveToThread(m_thread);
+  connect(m_thread, &QThread::started, m_worker, &RegistrationWorker::run);
+  connect(m_worker, &RegistrationWorker::progressed, this, &RegisterStepWidget::onProgress);
+  connect(m_worker, &RegistrationWorker::finished, this, &RegisterStepWidget::onFinished);
+  connect(m_worker, &RegistrationWorker::failed, this, &RegisterStepWidget::onFailed);
+  setRunningUi(true);
+  showMessage(tr("Registering…"), false);
+  m_thread->start();
+  emit runningChanged(true);
+  return true;
+}
+
+void RegisterStepWidget::cancel() {
+  if (!m_worker) return;
+  m_worker->cancel();
+  m_cancelButton->setEnabled(false);
+  showMessage(tr("Cancelling: the run stops at the next DRR and keeps the best pose so far."), false);
+}
+
+void RegisterStepWidget::onProgress(const RegistrationProgress& progress) {
+  if (progress.stageIndex != m_lastProgress.stageIndex || m_lastProgress.stage.empty()) {
+    appendLog(tr("Stage %1/%2: %3")
+                  .arg(progress.stageIndex + 1)
+                  .arg(progress.stageCount)
+                  .arg(QString::fromStdString(progress.stage)));
+  }
+  m_lastProgress = progress;
+  m_progressBar->setValue(static_cast<int>(1000.0 * progress.fraction));
+  m_progressLabel->setText(tr("Stage %1/%2 %3 — %4 DRRs — best similarity %5")
+                               .arg(progress.stageIndex + 1)
+                               .arg(progress.stageCount)
+                               .arg(QString::fromStdString(progress.stage))
+                               .arg(progress.drrs)
+                               .arg(progress.bestSimilarity, 0, 'f', 4));
+}
+
+void RegisterStepWidget::onFinished(const RegistrationResult& result) {
+  endThread();
+  for (const StageReport& stage : result.stages) {
+    appendLog(QString::fromStdString(fmt::format(
+        "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}", stage.name,
+        stage.metric, stage.level, stage.search, stage.evaluations, stage.drrs, stage.startSimilarity,
+        stage.similarity, stage.seconds, stage.cancelled ? " (cancelled)" : "")));
+  }
+  QString summary = tr("%1 DRRs in %2 s").arg(result.totalDrrs).arg(result.totalSeconds, 0, 'f', 1);
+  if (result.cancelled) {
+    summary = tr("Cancelled: the best pose so far is kept, marked cancelled (%1).").arg(summary);
+  } else {
+    m_progressBar->setValue(m_progressBar->maximum());
+    summary = tr("Registered: %1. Judge the result in the Review step.").arg(summary);
+  }
+  if (m_inputsChangedDuringRun) {
+    summary = tr("The CT or the views changed during the run, so its result (%1) was not kept; run again.")
+                  .arg(summary);
+    appendLog(summary);
+    showMessage(summary, true);
+  } else {
+    appendLog(summary);
+    showMessage(summary, false);
+    m_document->setResult(result);
+  }
+  setRunningUi(false);
+  emit runningChanged(false);
+}
+
+void RegisterStepWidget::onFailed(const QString& message) {
+  endThread();
+  appendLog(tr("Failed: %1").arg(message));
+  showMessage(tr("Registration failed: %1").arg(message), true);
+  setRunningUi(false);
+  emit runningChanged(false);
+}
+
+void RegisterStepWidget::endThread() {
+  if (!m_thread) return;
+  m_thread->quit();
+  m_thread->wait();
+  delete m_worker;
+  delete m_thread;
+  m_worker = nullptr;
+  m_thread = nullptr;
+}
+
+void RegisterStepWidget::setRunningUi(bool running) {
+  m_runButton->setEnabled(!running);
+  m_cancelButton->setEnabled(running);
+  for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
+                                                          m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
+                                                          m_cmaesCheck}) {
+    control->setEnabled(!running);
+  }
+}
+
+}  // namespace fct

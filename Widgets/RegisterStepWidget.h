@@ -1,0 +1,108 @@
+#pragma once
+// RegisterStepWidget: the "Register" step. Preset, seed, DRR method and the paper's ablation switches; Run starts a
+// RegistrationWorker on its own thread from the document's initial pose, with the document's ROI window and
+// fraction in every ROI stage; a progress bar (stage, DRRs, best similarity) and a log follow it through queued
+// signals while the window stays responsive. Cancel stops the run at the next DRR set; the best pose so far is kept
+// and marked cancelled. The result (finished or cancelled) goes into the document, unless the CT or the views changed
+// during the run (then it is reported and dropped).
+
+#include <QString>
+#include <QWidget>
+
+#include <array>
+#include <vector>
+
+#include "Registration.h"
+
+class QCheckBox;
+class QComboBox;
+class QLabel;
+class QPlainTextEdit;
+class QProgressBar;
+class QPushButton;
+class QSpinBox;
+class QThread;
+
+namespace fct {
+
+class RegistrationWorker;
+class SliceViewWidget;
+class StudioDocument;
+class XrayViewWidget;
+
+/// The Register step: runs and cancels registrations with progress.
+class RegisterStepWidget : public QWidget {
+  Q_OBJECT
+ public:
+  /// A step running registrations on `document`.
+  explicit RegisterStepWidget(StudioDocument* document, QWidget* parent = nullptr);
+  /// Cancels a running registration and waits for its thread.
+  ~RegisterStepWidget() override;
+
+  /// The views (this step draws nothing on them; kept for the common step interface).
+  void attachViews(std::vector<XrayViewWidget*> xrayViews, std::array<SliceViewWidget*, 3> sliceViews);
+  /// Activating shows whether the step is ready (initial pose, ROI settings); a started run goes on either way.
+  void setActive(bool active);
+
+  /// True while a registration runs.
+  bool isRunning() const { return m_thread != nullptr; }
+  /// The ablation switches in effect.
+  RegistrationAblation ablation() const;
+  /// Sets the ablation switches' check boxes.
+  void setAblation(const RegistrationAblation& ablation);
+  /// The last progress report of the current or last run.
+  const RegistrationProgress& lastProgress() const { return m_lastProgress; }
+  /// The message line, as shown.
+  QString message() const;
+  /// The log text.
+  QString logText() const;
+
+ public slots:
+  /// Starts a registration; false (with the reason shown) when one runs already or the CT, views, initial pose,
+  /// preset or ROI settings are missing or wrong.
+  bool run();
+  /// Asks the running registration to stop (no effect when none runs).
+  void cancel();
+
+ signals:
+  /// A run started (true) or ended (false).
+  void runningChanged(bool running);
+
+ private:
+  void onProgress(const RegistrationProgress& progress);
+  void onFinished(const RegistrationResult& result);
+  void onFailed(const QString& message);
+  /// Stops and deletes the worker thread (its run has returned or is about to).
+  void endThread();
+  /// Enables the controls for the running state.
+  void setRunningUi(bool running);
+  /// Copies the document's options into the controls.
+  void syncControls();
+  /// Writes the controls' options into the document.
+  void pushOptions();
+  void appendLog(const QString& line);
+  void showMessage(const QString& text, bool error);
+
+  StudioDocument* m_document;
+  QThread* m_thread = nullptr;
+  RegistrationWorker* m_worker = nullptr;
+  RegistrationProgress m_lastProgress;
+  bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
+
+  QComboBox* m_presetCombo;
+  QSpinBox* m_seedSpin;
+  QComboBox* m_methodCombo;
+  QCheckBox* m_noRoisCheck;
+  QCheckBox* m_noPyramidCheck;
+  QCheckBox* m_nccOnlyCheck;
+  QCheckBox* m_localOnlyCheck;
+  QCheckBox* m_cmaesCheck;
+  QPushButton* m_runButton;
+  QPushButton* m_cancelButton;
+  QProgressBar* m_progressBar;
+  QLabel* m_progressLabel;
+  QLabel* m_message;
+  QPlainTextEdit* m_log;
+};
+
+}  // namespace fct
