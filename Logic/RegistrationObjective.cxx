@@ -10,9 +10,8 @@
 namespace fct {
 
 Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
-                                                            const RegistrationStage& stage) {
+                                                            const RegistrationStage& stage, bool useViewRenderers) {
   RegistrationObjective objective;
-  objective.m_renderer = &registrationCase.renderer();
   objective.m_level = stage.level;
   const int level = stage.level;
   auto where = [&](std::size_t v) { return fmt::format("stage '{}', view '{}'", stage.name, registrationCase.viewName(v)); };
@@ -24,6 +23,8 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
     const PyramidLevel& pyramidLevel = registrationCase.prepared(v).pyramid.level(level);
     View view;
+    view.renderer = useViewRenderers ? &registrationCase.renderer(v) : &registrationCase.renderer();
+    view.transgraph = useViewRenderers ? registrationCase.transgraph(v) : nullptr;
     view.camera = registrationCase.camera(v);
     const std::size_t validCount = pyramidLevel.mask.validCount();
 
@@ -80,14 +81,16 @@ Result<double> RegistrationObjective::similarity(const Eigen::Isometry3d& T_worl
   tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
     View& view = m_views[v];
     if (view.wholeLevel) {
-      view.status = m_renderer->render(view.camera, T_world_from_ct, m_level, view.drr);
+      view.status = view.renderer->render(view.camera, T_world_from_ct, m_level, view.drr);
     } else {
-      view.status = m_renderer->renderPixels(view.camera, T_world_from_ct, m_level, view.pixels, view.values);
+      view.status = view.renderer->renderPixels(view.camera, T_world_from_ct, m_level, view.pixels, view.values);
       if (view.status) {
         for (std::size_t i = 0; i < view.pixels.size(); ++i) view.drr.pixels[view.pixels[i]] = view.values[i];
       }
     }
     if (!view.status) return;
+    // The view's renderer serves only this view, so its last-render count is this render's.
+    view.fallbackRays = view.transgraph ? view.transgraph->lastFallbackRayCount() : 0;
     auto score = view.metric->evaluate(view.drr);
     if (!score) {
       view.status = fail(score.error());
@@ -99,10 +102,15 @@ Result<double> RegistrationObjective::similarity(const Eigen::Isometry3d& T_worl
   double sum = 0.0;
   for (std::size_t v = 0; v < m_views.size(); ++v) {
     if (!m_views[v].status) return fail(m_views[v].status.error());
+    m_fallbackRays += static_cast<long>(m_views[v].fallbackRays);
     sum += m_views[v].score;
     m_lastPerView[v] = m_views[v].score;
   }
   return sum / static_cast<double>(m_views.size());
+}
+
+std::string_view RegistrationObjective::drrMethodName() const {
+  return m_views.empty() ? std::string_view() : m_views.front().renderer->methodName();
 }
 
 std::vector<double> RegistrationObjective::keptFractions() const {

@@ -65,6 +65,13 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   stage.metric = parseName(reader, "metric", kMetrics);
   stage.level = reader.integer("level", 0);
   if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
+  if (const nlohmann::json* exact = reader.find("exact_drr")) {
+    if (exact->is_boolean()) {
+      stage.exactDrr = exact->get<bool>();
+    } else {
+      reader.rejectKey("exact_drr", fmt::format("is {}; use true or false", JsonReader::describe(*exact)));
+    }
+  }
 
   if (const nlohmann::json* pixels = reader.find("pixels")) {
     JsonReader pixelReader(*pixels, where + ": pixels");
@@ -132,6 +139,7 @@ std::vector<std::string> RegistrationAblation::activeNames() const {
   if (nccOnly) names.emplace_back("ncc-only");
   if (localOnly) names.emplace_back("local-only");
   if (cmaesForGenetic) names.emplace_back("cmaes");
+  if (noTransgraph) names.emplace_back("no-transgraph");
   return names;
 }
 
@@ -218,6 +226,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
     stagesJson.push_back({{"name", s.name},
                           {"metric", metricName(s.metric)},
                           {"level", s.level},
+                          {"exact_drr", s.exactDrr},
                           {"pixels", std::move(pixels)},
                           {"search", std::move(search)}});
   }

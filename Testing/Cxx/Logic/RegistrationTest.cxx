@@ -168,20 +168,6 @@ TEST(Registration, OtherDrrMethodsRegisterToo) {
   EXPECT_LT(errorOf(p, result.value().T_world_from_ct), 1.0);
 }
 
-TEST(Registration, TransgraphMethodIsRefusedClearlyUntilPerViewTablesExist) {
-  fct::RegistrationCaseOptions caseOptions;
-  caseOptions.drr.method = fct::DrrMethod::Transgraph;
-  const fct::Volume ct = fct::Volume::create({8, 8, 8}, {1, 1, 1}).value();
-  fct::XrayImage xray;
-  xray.cols = 4;
-  xray.rows = 4;
-  xray.pixels.assign(16, 1.0f);
-  const fct::Camera camera = fct::Camera::lookingAt(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 500, 1000, 4, 4, 1.0);
-  const auto created = fct::RegistrationCase::create(ct, {fct::RegistrationView{"ap", xray, camera, {}}}, caseOptions);
-  ASSERT_FALSE(created.ok());
-  EXPECT_NE(created.error().find("use --method siddon or raycast"), std::string::npos) << created.error();
-}
-
 TEST(Registration, CancelMidStageReturnsBestPoseSoFarMarkedCancelled) {
   Prepared p = preparePhantom();
   const Eigen::Isometry3d start = fct::test::startPose(p.registrationCase, p.simulated.T_truth, 10.0, 3);
