@@ -344,7 +344,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                       "(green) pose over the X-ray");
   command->add_flag("--progress", options->progress, "Show a live progress bar on stderr");
   command->add_flag("--no-fov", options->noFieldOfView,
-                    "Skip the field-of-view (collimator) detection, e.g. for simulated X-rays without a collimator");
+                    "Skip the field-of-view (collimator) detection (use every pixel but the margin band)");
   command->add_flag("--no-rois", options->ablation.noDynamicRois, "Ablation: every valid pixel instead of dynamic ROIs");
   command->add_flag("--no-pyramid", options->ablation.noPyramid, "Ablation: full resolution in every stage");
   command->add_flag("--ncc-only", options->ablation.nccOnly, "Ablation: NCC in every stage (no VLNC)");

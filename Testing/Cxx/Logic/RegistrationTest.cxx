@@ -83,11 +83,9 @@ TEST(Registration, FastPresetRecoversPelvisPoseFrom10mm) {
   ASSERT_TRUE(ct.ok()) << ct.error();
   auto simulated = fct::test::simulateCase(std::move(ct).value());
   ASSERT_TRUE(simulated.ok()) << simulated.error();
-  // The simulated X-rays have no collimator; the pelvis fills the lateral view up to the image border, where the
-  // field-of-view detector would take its darkest band for a border region.
-  fct::RegistrationCaseOptions caseOptions;
-  caseOptions.preparation.detectFieldOfView = false;
-  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, caseOptions);
+  // The pelvis fills the lateral view up to the image border; the field-of-view detector sees no collimator edge there
+  // and keeps the whole image (FieldOfViewDetectorTest).
+  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views);
   ASSERT_TRUE(registrationCase.ok()) << registrationCase.error();
   Prepared p{std::move(simulated).value(), std::move(registrationCase).value()};
   // Fewer starts than the phantom to bound the CI time (see README); the same criterion per start.
