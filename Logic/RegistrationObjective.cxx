@@ -3,11 +3,30 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <cmath>
+
 #include "GradientCorrelationSimilarity.h"
 #include "NccSimilarity.h"
 #include "VlncSimilarity.h"
 
 namespace fct {
+
+namespace {
+
+/// The pixels of `pixels` (linear indices of a level `cols` wide) on every k-th column and row, k the smallest stride
+/// that keeps at most maxPixels of them (approximately: the valid pixels are assumed evenly spread).
+PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int maxPixels) {
+  if (pixels.size() <= static_cast<std::size_t>(maxPixels)) return pixels;
+  const int k = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(pixels.size()) / maxPixels)));
+  PixelIndexList kept;
+  kept.reserve(pixels.size() / (static_cast<std::size_t>(k) * k) + 1);
+  for (const std::int32_t index : pixels) {
+    if ((index % cols) % k == 0 && (index / cols) % k == 0) kept.push_back(index);
+  }
+  return kept;
+}
+
+}  // namespace
 
 Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
                                                             const RegistrationStage& stage, bool useViewRenderers) {
@@ -40,6 +59,7 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
       view.pixels = selection.pixels;
     } else {
       view.pixels = pyramidLevel.mask.pixelList();
+      if (stage.pixels.maxPixels > 0) view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stage.pixels.maxPixels);
     }
     if (view.pixels.empty()) {
       return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}); reduce the masks or use a "

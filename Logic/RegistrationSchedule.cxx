@@ -78,6 +78,7 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
     stage.pixels.kind = parseName(pixelReader, "set", kPixelSets);
     optionalInteger(pixelReader, "window", 2, stage.pixels.windowSize);
     optionalNumber(pixelReader, "fraction", stage.pixels.targetFraction);
+    optionalInteger(pixelReader, "max_pixels", 0, stage.pixels.maxPixels);
     if (pixelReader.ok() && stage.pixels.windowSize > 64) {
       pixelReader.rejectKey("window", fmt::format("is {}; use 2 to 64 pixels", stage.pixels.windowSize));
     }
@@ -206,6 +207,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
   for (const RegistrationStage& s : stages) {
     nlohmann::ordered_json pixels{{"set", nameOf(s.pixels.kind, kPixelSets)}, {"window", s.pixels.windowSize}};
     if (s.pixels.kind == PixelSetKind::Rois) pixels["fraction"] = s.pixels.targetFraction;
+    if (s.pixels.maxPixels > 0) pixels["max_pixels"] = s.pixels.maxPixels;
     nlohmann::ordered_json search{{"strategy", searchName(s.search)}, {"max_evaluations", s.maxEvaluations}};
     search["guesses"] = s.genetic.randomGuesses;
     search["spread_deg"] = s.genetic.spreadRotation_deg;

@@ -35,6 +35,9 @@ struct PixelSetSpec {
   PixelSetKind kind = PixelSetKind::WholeImage;
   int windowSize = 7;            ///< w, pixels of the stage's level (ROIs, and VLNC windows of a whole image)
   double targetFraction = 0.12;  ///< ROIs: fraction of the valid pixels kept (0 < f <= 1; the paper: 0.10-0.15)
+  /// Whole-image NCC/GC sets: at most this many pixels per view, by keeping every k-th column and row (k as small as
+  /// fits); 0 = no cap. A large detector's coarse level then costs like a small one's (VLNC and ROI sets ignore it).
+  int maxPixels = 0;
 };
 
 /// One stage of the schedule. Option units follow the optimizers: scaled units (about 1 mm of bone-surface motion),

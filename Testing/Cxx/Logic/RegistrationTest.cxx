@@ -7,6 +7,7 @@
 
 #include "PhantomBuilder.h"
 #include "Registration.h"
+#include "RegistrationObjective.h"
 #include "RegistrationTestCase.h"
 #include "TestSupport.h"
 #include "VolumeFileIO.h"
@@ -151,6 +152,26 @@ TEST(Registration, EachAblationSwitchStillRuns) {
     if (ablation.cmaesForGenetic) EXPECT_EQ(result.value().stages[0].search, "cmaes");
     EXPECT_LT(errorOf(p, result.value().T_world_from_ct), errorOf(p, start));
   }
+}
+
+TEST(RegistrationObjective, WholeImageSetKeepsAtMostMaxPixelsOnARegularGrid) {
+  Prepared p = preparePhantom({}, coarseDetector());
+  fct::RegistrationStage stage = fastOptions().schedule.stages.front();
+  stage.level = 1;  // 64x64 pixels
+  stage.pixels.maxPixels = 0;
+  auto all = fct::RegistrationObjective::create(p.registrationCase, stage);
+  stage.pixels.maxPixels = 1500;
+  auto capped = fct::RegistrationObjective::create(p.registrationCase, stage);
+  ASSERT_TRUE(all.ok() && capped.ok()) << all.error() << capped.error();
+  for (std::size_t v = 0; v < 3; ++v) {
+    const std::size_t n = all.value().renderedPixelCounts()[v];
+    const std::size_t kept = capped.value().renderedPixelCounts()[v];
+    EXPECT_GT(n, 3000u);
+    EXPECT_LE(kept, 1500u);
+    EXPECT_GE(kept, n / 9) << "the smallest stride that fits (2 here)";
+  }
+  const double similarity = capped.value().similarity(p.simulated.T_truth).value();
+  EXPECT_GT(similarity, 0.9) << "the subsampled NCC still sees the match";
 }
 
 TEST(Registration, OtherDrrMethodsRegisterToo) {
