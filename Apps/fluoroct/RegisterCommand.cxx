@@ -228,7 +228,15 @@ int runRegister(const Options& o) {
   caseOptions.preparation.detectFieldOfView = !o.noFieldOfView;
   g_cancel = false;
   const auto previousHandler = std::signal(SIGINT, onInterrupt);
-  auto registrationCase = RegistrationCase::create(ct.value(), views, caseOptions, ProgressMonitor({}, &g_cancel));
+  ProgressMonitor::Callback onTableProgress;
+  if (o.progress) {
+    onTableProgress = [](const ProgressUpdate& u) {
+      fmt::print(stderr, "\r{}: {:3.0f}% {:<40}", u.stage, 100.0 * u.fraction, u.message);
+    };
+  }
+  auto registrationCase =
+      RegistrationCase::create(ct.value(), views, caseOptions, ProgressMonitor(onTableProgress, &g_cancel));
+  if (onTableProgress && caseOptions.drr.method == DrrMethod::Transgraph) fmt::print(stderr, "\n");
   if (!registrationCase) {
     std::signal(SIGINT, previousHandler);
     return reportError(registrationCase.error());
