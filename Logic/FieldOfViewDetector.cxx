@@ -99,10 +99,11 @@ Result<FieldOfView> FieldOfViewDetector::detect(const FloatImage& image) const {
     return fail(fmt::format("cannot detect a field of view in a {}x{} image with {} pixels; need at least 3x3",
                             image.cols, image.rows, image.pixels.size()));
   }
-  if (!(o.backgroundLevel > 0.0 && o.backgroundLevel < 1.0) || o.inset_px < 0 || !(o.maxCircleResidual_px > 0.0)) {
+  if (!(o.backgroundLevel > 0.0 && o.backgroundLevel < 1.0) || o.inset_px < 0 || !(o.maxCircleResidual_px > 0.0) ||
+      o.edgeWidth_px < 1 || !(o.minEdgeStep >= 1.0)) {
     return fail(fmt::format("field-of-view options out of range: backgroundLevel {} (0..1), inset {} px (>= 0), "
-                            "max circle residual {} px (> 0)",
-                            o.backgroundLevel, o.inset_px, o.maxCircleResidual_px));
+                            "max circle residual {} px (> 0), edge width {} px (>= 1), min edge step {} (>= 1)",
+                            o.backgroundLevel, o.inset_px, o.maxCircleResidual_px, o.edgeWidth_px, o.minEdgeStep));
   }
   if (!std::all_of(image.pixels.begin(), image.pixels.end(), [](float v) { return std::isfinite(v); })) {
     return fail("X-ray has non-finite pixel values (NaN or infinity); cannot detect its field of view");
@@ -128,6 +129,24 @@ Result<FieldOfView> FieldOfViewDetector::detect(const FloatImage& image) const {
   const std::size_t backgroundCount = static_cast<std::size_t>(std::count(background.begin(), background.end(), 1));
   result.backgroundFraction = static_cast<double>(backgroundCount) / static_cast<double>(background.size());
   if (result.backgroundFraction < o.minBackgroundFraction) return result;
+
+  // A collimator or image-intensifier edge is a step: the field pixels next to the background are well above the
+  // threshold. Anatomy reaching the border of a collimator-free image (e.g. a simulated lateral pelvis) only fades
+  // through the threshold: then the dark region is not background and the whole image is field.
+  cv::Mat backgroundImage(rows, cols, CV_8U);
+  std::copy(background.begin(), background.end(), backgroundImage.data);
+  cv::Mat near;
+  const int band = 2 * o.edgeWidth_px + 1;
+  cv::dilate(backgroundImage, near, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(band, band)));
+  std::vector<double> edgeLevels;
+  for (std::size_t i = 0; i < background.size(); ++i) {
+    if (near.data[i] && !background[i]) edgeLevels.push_back((image.pixels[i] - minimum) / (threshold - minimum));
+  }
+  result.edgeStep = edgeLevels.empty() ? 0.0 : medianOf(std::move(edgeLevels));
+  if (result.edgeStep < o.minEdgeStep) {
+    result.backgroundFraction = 0.0;
+    return result;
+  }
 
   std::vector<Eigen::Vector2d> boundary;
   for (int row = 1; row + 1 < rows; ++row) {

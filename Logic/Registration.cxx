@@ -61,21 +61,35 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
   if (auto overlap = registrationCase.checkOverlap(T_initial, schedule.stages.front().level); !overlap) {
     return fail(overlap.error());
   }
+  const ProgressMonitor monitor(ProgressMonitor::Callback{}, cancel);
+  const bool useViewRenderers = !options.ablation.noTransgraph;
+  if (useViewRenderers && !registrationCase.viewRenderersReady()) {
+    const auto setupStart = Clock::now();
+    const Status tables = registrationCase.prepareViewRenderers(T_initial, monitor);
+    if (!tables) {
+      if (monitor.cancelled()) {
+        result.cancelled = true;
+        result.T_initial = result.T_world_from_ct = T_initial;
+        result.totalSeconds = secondsSince(runStart);
+        return result;
+      }
+      return fail(tables.error());
+    }
+    result.viewRendererSetupSeconds = secondsSince(setupStart);
+  }
   result.T_initial = T_initial;
   result.rotationCentre_ct_mm = registrationCase.rotationCentre_ct_mm();
-  result.drrMethod = std::string(registrationCase.renderer().methodName());
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) result.viewNames.push_back(registrationCase.viewName(v));
 
   // Every stage's pixel sets and metrics are built before the first search, so a stage that cannot run fails the
   // registration at once instead of after the earlier stages' work.
   std::vector<RegistrationObjective> objectives;
   for (const RegistrationStage& stage : schedule.stages) {
-    auto created = RegistrationObjective::create(registrationCase, stage);
+    auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr);
     if (!created) return fail(created.error());
     objectives.push_back(std::move(created).value());
   }
-
-  const ProgressMonitor monitor(ProgressMonitor::Callback{}, cancel);
+  result.drrMethod = std::string(objectives.front().drrMethodName());
   PoseVector current = initialParams.value().asVector();
   const int stageCount = static_cast<int>(schedule.stages.size());
 
@@ -137,6 +151,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       return fail(fmt::format("stage '{}': {}", stage.name, found.error()));
     }
     report.drrs = objective.drrCount();
+    report.fallbackRays = objective.fallbackRayCount();
     report.seconds = secondsSince(stageStart);
     result.totalDrrs += report.drrs;
     result.stages.push_back(std::move(report));
@@ -146,7 +161,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
     }
   }
   result.T_world_from_ct = registrationCase.poseTransform(current);
-  result.totalSeconds = secondsSince(runStart);
+  result.totalSeconds = secondsSince(runStart) - result.viewRendererSetupSeconds;
   return result;
 }
 

@@ -5,6 +5,9 @@
 // the bone centre and translations (mm), scaled by the bone radius (RegistrationCase::scales).
 // A stage never ends worse than it started: if its search finds nothing better, the start pose is kept.
 // Cancelling (the flag is checked before every DRR set) ends the run at once with the best pose so far, marked.
+// Transgraph method: a case whose tables do not exist yet gets them built around the initial pose first (timed apart
+// from the registration, RegistrationResult::viewRendererSetupSeconds); the noTransgraph ablation renders every view
+// with the case's exact (Siddon) renderer instead.
 
 #include <Eigen/Geometry>
 
@@ -49,6 +52,7 @@ struct StageReport {
   std::string search;              ///< "genetic", "cmaes", "local"
   double seconds = 0.0;
   long drrs = 0;                   ///< DRRs rendered in the stage (evaluations x views)
+  long fallbackRays = 0;           ///< Transgraph rays outside their table, integrated exactly (0 for other methods)
   int evaluations = 0;
   double startSimilarity = 0.0;    ///< at the stage's start pose
   double similarity = 0.0;         ///< at the stage's final pose (>= startSimilarity)
@@ -62,11 +66,14 @@ struct RegistrationResult {
   Eigen::Isometry3d T_initial = Eigen::Isometry3d::Identity();        ///< the initial pose
   Eigen::Vector3d rotationCentre_ct_mm = Eigen::Vector3d::Zero();
   std::vector<StageReport> stages;  ///< the stages run (up to the cancelled one)
-  double totalSeconds = 0.0;
+  double totalSeconds = 0.0;       ///< the registration itself (stages), without viewRendererSetupSeconds
   long totalDrrs = 0;
+  /// Transgraph tables built (or loaded from the cache) by this run before its first stage, seconds; 0 when the case
+  /// had them already (RegistrationCase::viewRendererSetupSeconds() tells how long they took there).
+  double viewRendererSetupSeconds = 0.0;
   bool cancelled = false;           ///< the run was cancelled; T_world_from_ct is the best pose so far
   RegistrationSchedule schedule;    ///< the schedule actually run (ablations and seed applied)
-  std::string drrMethod;
+  std::string drrMethod;           ///< the DRR method the stages rendered with ("transgraph", "siddon", ...)
   std::vector<std::string> viewNames;
 };
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -11,21 +12,22 @@
 namespace fct {
 
 Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::vector<RegistrationView>& views,
-                                                  const RegistrationCaseOptions& options) {
+                                                  const RegistrationCaseOptions& options,
+                                                  const ProgressMonitor& monitor) {
   if (views.empty()) return fail("registration needs at least one X-ray view; the view list is empty");
   RegistrationCase result;
 
   auto drrVolume = DrrVolume::create(ct);
   if (!drrVolume) return fail("CT: " + drrVolume.error());
   result.m_drrVolume = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
-  if (options.drr.method == DrrMethod::Transgraph) {
-    // One renderer serves every view here, while a Transgraph table belongs to one view and expected pose.
-    return fail("registration with the transgraph DRR method is not available yet (it needs one table per view "
-                "around the initial pose); use --method siddon or raycast");
-  }
-  auto renderer = DrrRendererFactory::create(result.m_drrVolume, options.drr);
+  result.m_drrOptions = options.drr;
+  // The exact renderer: the method's own, or Siddon under the per-view Transgraphs.
+  DrrRendererOptions exact = options.drr;
+  if (exact.method == DrrMethod::Transgraph) exact.method = DrrMethod::Siddon;
+  auto renderer = DrrRendererFactory::create(result.m_drrVolume, exact);
   if (!renderer) return fail(renderer.error());
   result.m_renderer = std::move(renderer).value();
+  result.m_viewRenderersReady = options.drr.method != DrrMethod::Transgraph;
 
   for (const RegistrationView& view : views) {
     const CameraIntrinsics& in = view.camera.intrinsics();
@@ -55,7 +57,7 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
                               "register against (check the image file)",
                               view.name, lo, level0.mask.validCount()));
     }
-    result.m_views.push_back(View{view.name, view.camera, std::move(prepared).value(), {}});
+    result.m_views.push_back(View{view.name, view.camera, std::move(prepared).value(), {}, result.m_renderer, nullptr});
   }
 
   auto bone = BoneSurface::extract(ct, options.boneThreshold_hu);
@@ -71,12 +73,41 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   auto scales = PoseOptimizer::scalesForBoneRadius(result.m_boneRadius_mm);
   if (!scales) return fail("bone radius: " + scales.error());
   result.m_scales = scales.value();
+  std::vector<std::string> warnings;
+  if (options.T_expected_world_from_ct) {
+    const Status tables = result.prepareViewRenderers(*options.T_expected_world_from_ct, monitor);
+    if (!tables) return fail(tables.error());
+    warnings = tables.warnings();
+  }
   Result<RegistrationCase> out(std::move(result));
+  for (std::string& warning : warnings) out.addWarning(std::move(warning));
   if (!bone) {
     out.addWarning(fmt::format("no bone surface at {} HU ({}); rotating about the volume centre", options.boneThreshold_hu,
                                bone.error()));
   }
   return out;
+}
+
+Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expected_world_from_ct,
+                                              const ProgressMonitor& monitor) {
+  if (m_viewRenderersReady) return Ok{};
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::shared_ptr<const DrrRenderer>> renderers;
+  Status status = Ok{};
+  for (const View& view : m_views) {
+    auto created = DrrRendererFactory::createForView(m_drrVolume, m_drrOptions, view.camera, T_expected_world_from_ct,
+                                                     monitor);
+    if (!created) return fail(fmt::format("view '{}': Transgraph: {}", view.name, created.error()));
+    for (const std::string& warning : created.warnings()) status.addWarning(fmt::format("view '{}': {}", view.name, warning));
+    renderers.push_back(std::move(created).value());
+  }
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    m_views[v].renderer = renderers[v];
+    m_views[v].transgraph = dynamic_cast<const TransgraphRenderer*>(renderers[v].get());
+  }
+  m_viewRenderersReady = true;
+  m_viewRendererSetup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return status;
 }
 
 Result<const DynamicRoiSelector*> RegistrationCase::selector(std::size_t v, int level, int windowSize) {

@@ -1,8 +1,14 @@
 #pragma once
 // RegistrationCase: everything about one registration problem that is computed once and reused by every stage and
-// every pose: the CT prepared for DRRs and its renderer, each view's prepared X-ray (masks, line integrals, pyramid
+// every pose: the CT prepared for DRRs and its renderers, each view's prepared X-ray (masks, line integrals, pyramid
 // with exact cameras), the dynamic-ROI statistics per view, level and window size (selections are then instant),
 // and the bone's centre (the rotation centre of the pose parameters) and radius (the parameter scales).
+//
+// Renderers: one per view. For the view-independent methods (siddon, raycast) every view shares the method's renderer.
+// For the transgraph method each view gets its own Transgraph (a ray table of that view's detector, valid for poses
+// near an expected pose, built or loaded from the disk cache) and the exact renderer is Siddon: it serves rays outside
+// a table (counted per render), the overlap check, and runs with the Transgraph switched off (ablation). A table is
+// read back at the pixel rays of any pyramid level: it stores rays, not pixels, and covers the full detector's extent.
 
 #include <Eigen/Geometry>
 
@@ -21,7 +27,9 @@
 #include "DynamicRoiSelector.h"
 #include "PixelCircle.h"
 #include "PoseOptimizer.h"
+#include "ProgressMonitor.h"
 #include "Result.h"
+#include "TransgraphRenderer.h"
 #include "Volume.h"
 #include "XrayImage.h"
 #include "XrayPreparation.h"
@@ -42,19 +50,40 @@ struct RegistrationCaseOptions {
   DrrRendererOptions drr;                  ///< DRR method ("siddon", "raycast", ...)
   XrayPreparationOptions preparation;      ///< masks, intensity model, pyramid levels (spheres come per view)
   double boneThreshold_hu = 250.0;         ///< iso-value of the bone surface giving the rotation centre and radius
+  /// Transgraph method: the pose (CT mm -> world mm, LPS) around which each view's table is built, e.g. the initial
+  /// pose from landmarks. nullopt: the tables are built at the initial pose of the first Registration::run.
+  std::optional<Eigen::Isometry3d> T_expected_world_from_ct;
 };
 
 /// A prepared registration problem: CT, renderer and views.
 class RegistrationCase {
  public:
-  /// Prepares the CT and every view. Fails, naming the view, on no view, a camera whose detector differs from its
-  /// image, a failed X-ray preparation, or an X-ray constant over its valid pixels (nothing to register against).
-  /// A CT without bone above the threshold uses the volume centre and a quarter of its diagonal (with a warning).
+  /// Prepares the CT and every view, and for the transgraph method with an expected pose each view's table (the
+  /// monitor sees the builds and can cancel them). Fails, naming the view, on no view, a camera whose detector differs
+  /// from its image, a failed X-ray preparation, an X-ray constant over its valid pixels (nothing to register
+  /// against), or a table that cannot be planned or built. A CT without bone above the threshold uses the volume
+  /// centre and a quarter of its diagonal (with a warning); Transgraph cache problems are warnings too.
   static Result<RegistrationCase> create(const Volume& ct, const std::vector<RegistrationView>& views,
-                                         const RegistrationCaseOptions& options = {});
+                                         const RegistrationCaseOptions& options = {},
+                                         const ProgressMonitor& monitor = {});
 
-  /// The DRR renderer of the CT.
+  /// The exact DRR renderer shared by all views: the method's renderer, Siddon for the transgraph method.
   const DrrRenderer& renderer() const { return *m_renderer; }
+  /// The renderer of view v: its Transgraph once built (transgraph method), else renderer().
+  const DrrRenderer& renderer(std::size_t v) const { return *m_views[v].renderer; }
+  /// The Transgraph renderer of view v, or null (other method, or tables not built yet).
+  const TransgraphRenderer* transgraph(std::size_t v) const { return m_views[v].transgraph; }
+  /// The DRR method the case was prepared with.
+  DrrMethod drrMethod() const { return m_drrOptions.method; }
+  /// True when every view has its final renderer (always, except for the transgraph method before its tables exist).
+  bool viewRenderersReady() const { return m_viewRenderersReady; }
+  /// Transgraph method: builds (or loads from the cache) each view's table around T_expected_world_from_ct, unless
+  /// they exist already (then nothing changes: tables are built once per case). Other methods: nothing to do. Fails,
+  /// naming the view, when a table cannot be planned or built, or when the monitor cancels; cache problems are
+  /// warnings of the result.
+  Status prepareViewRenderers(const Eigen::Isometry3d& T_expected_world_from_ct, const ProgressMonitor& monitor = {});
+  /// Wall time of the table builds or cache loads of prepareViewRenderers(), seconds (0 for other methods).
+  double viewRendererSetupSeconds() const { return m_viewRendererSetup_s; }
   /// Number of views.
   std::size_t viewCount() const { return m_views.size(); }
   /// Name of view v.
@@ -95,12 +124,17 @@ class RegistrationCase {
     Camera camera;
     PreparedXray prepared;
     std::map<std::pair<int, int>, DynamicRoiSelector> selectors;  ///< by (level, window size)
+    std::shared_ptr<const DrrRenderer> renderer;                  ///< the view's renderer (see renderer(v))
+    const TransgraphRenderer* transgraph = nullptr;               ///< the same renderer when it is a Transgraph
   };
   /// The ROI statistics of view v at (level, window), computed on first use.
   Result<const DynamicRoiSelector*> selector(std::size_t v, int level, int windowSize);
 
   std::shared_ptr<const DrrVolume> m_drrVolume;
   std::shared_ptr<const DrrRenderer> m_renderer;
+  DrrRendererOptions m_drrOptions;
+  bool m_viewRenderersReady = true;
+  double m_viewRendererSetup_s = 0.0;
   std::vector<View> m_views;
   std::optional<BoneSurface> m_bone;
   Eigen::Vector3d m_centre_ct_mm = Eigen::Vector3d::Zero();

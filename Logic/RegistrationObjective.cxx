@@ -3,16 +3,34 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <cmath>
+
 #include "GradientCorrelationSimilarity.h"
 #include "NccSimilarity.h"
 #include "VlncSimilarity.h"
 
 namespace fct {
 
+namespace {
+
+/// The pixels of `pixels` (linear indices of a level `cols` wide) on every k-th column and row, k the smallest stride
+/// that keeps at most maxPixels of them (approximately: the valid pixels are assumed evenly spread).
+PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int maxPixels) {
+  if (pixels.size() <= static_cast<std::size_t>(maxPixels)) return pixels;
+  const int k = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(pixels.size()) / maxPixels)));
+  PixelIndexList kept;
+  kept.reserve(pixels.size() / (static_cast<std::size_t>(k) * k) + 1);
+  for (const std::int32_t index : pixels) {
+    if ((index % cols) % k == 0 && (index / cols) % k == 0) kept.push_back(index);
+  }
+  return kept;
+}
+
+}  // namespace
+
 Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
-                                                            const RegistrationStage& stage) {
+                                                            const RegistrationStage& stage, bool useViewRenderers) {
   RegistrationObjective objective;
-  objective.m_renderer = &registrationCase.renderer();
   objective.m_level = stage.level;
   const int level = stage.level;
   auto where = [&](std::size_t v) { return fmt::format("stage '{}', view '{}'", stage.name, registrationCase.viewName(v)); };
@@ -24,6 +42,8 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
     const PyramidLevel& pyramidLevel = registrationCase.prepared(v).pyramid.level(level);
     View view;
+    view.renderer = useViewRenderers ? &registrationCase.renderer(v) : &registrationCase.renderer();
+    view.transgraph = useViewRenderers ? registrationCase.transgraph(v) : nullptr;
     view.camera = registrationCase.camera(v);
     const std::size_t validCount = pyramidLevel.mask.validCount();
 
@@ -39,6 +59,7 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
       view.pixels = selection.pixels;
     } else {
       view.pixels = pyramidLevel.mask.pixelList();
+      if (stage.pixels.maxPixels > 0) view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stage.pixels.maxPixels);
     }
     if (view.pixels.empty()) {
       return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}); reduce the masks or use a "
@@ -80,14 +101,16 @@ Result<double> RegistrationObjective::similarity(const Eigen::Isometry3d& T_worl
   tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
     View& view = m_views[v];
     if (view.wholeLevel) {
-      view.status = m_renderer->render(view.camera, T_world_from_ct, m_level, view.drr);
+      view.status = view.renderer->render(view.camera, T_world_from_ct, m_level, view.drr);
     } else {
-      view.status = m_renderer->renderPixels(view.camera, T_world_from_ct, m_level, view.pixels, view.values);
+      view.status = view.renderer->renderPixels(view.camera, T_world_from_ct, m_level, view.pixels, view.values);
       if (view.status) {
         for (std::size_t i = 0; i < view.pixels.size(); ++i) view.drr.pixels[view.pixels[i]] = view.values[i];
       }
     }
     if (!view.status) return;
+    // The view's renderer serves only this view, so its last-render count is this render's.
+    view.fallbackRays = view.transgraph ? view.transgraph->lastFallbackRayCount() : 0;
     auto score = view.metric->evaluate(view.drr);
     if (!score) {
       view.status = fail(score.error());
@@ -99,10 +122,15 @@ Result<double> RegistrationObjective::similarity(const Eigen::Isometry3d& T_worl
   double sum = 0.0;
   for (std::size_t v = 0; v < m_views.size(); ++v) {
     if (!m_views[v].status) return fail(m_views[v].status.error());
+    m_fallbackRays += static_cast<long>(m_views[v].fallbackRays);
     sum += m_views[v].score;
     m_lastPerView[v] = m_views[v].score;
   }
   return sum / static_cast<double>(m_views.size());
+}
+
+std::string_view RegistrationObjective::drrMethodName() const {
+  return m_views.empty() ? std::string_view() : m_views.front().renderer->methodName();
 }
 
 std::vector<double> RegistrationObjective::keptFractions() const {

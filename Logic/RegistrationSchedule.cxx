@@ -65,12 +65,20 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   stage.metric = parseName(reader, "metric", kMetrics);
   stage.level = reader.integer("level", 0);
   if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
+  if (const nlohmann::json* exact = reader.find("exact_drr")) {
+    if (exact->is_boolean()) {
+      stage.exactDrr = exact->get<bool>();
+    } else {
+      reader.rejectKey("exact_drr", fmt::format("is {}; use true or false", JsonReader::describe(*exact)));
+    }
+  }
 
   if (const nlohmann::json* pixels = reader.find("pixels")) {
     JsonReader pixelReader(*pixels, where + ": pixels");
     stage.pixels.kind = parseName(pixelReader, "set", kPixelSets);
     optionalInteger(pixelReader, "window", 2, stage.pixels.windowSize);
     optionalNumber(pixelReader, "fraction", stage.pixels.targetFraction);
+    optionalInteger(pixelReader, "max_pixels", 0, stage.pixels.maxPixels);
     if (pixelReader.ok() && stage.pixels.windowSize > 64) {
       pixelReader.rejectKey("window", fmt::format("is {}; use 2 to 64 pixels", stage.pixels.windowSize));
     }
@@ -132,6 +140,7 @@ std::vector<std::string> RegistrationAblation::activeNames() const {
   if (nccOnly) names.emplace_back("ncc-only");
   if (localOnly) names.emplace_back("local-only");
   if (cmaesForGenetic) names.emplace_back("cmaes");
+  if (noTransgraph) names.emplace_back("no-transgraph");
   return names;
 }
 
@@ -198,6 +207,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
   for (const RegistrationStage& s : stages) {
     nlohmann::ordered_json pixels{{"set", nameOf(s.pixels.kind, kPixelSets)}, {"window", s.pixels.windowSize}};
     if (s.pixels.kind == PixelSetKind::Rois) pixels["fraction"] = s.pixels.targetFraction;
+    if (s.pixels.maxPixels > 0) pixels["max_pixels"] = s.pixels.maxPixels;
     nlohmann::ordered_json search{{"strategy", searchName(s.search)}, {"max_evaluations", s.maxEvaluations}};
     search["guesses"] = s.genetic.randomGuesses;
     search["spread_deg"] = s.genetic.spreadRotation_deg;
@@ -218,6 +228,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
     stagesJson.push_back({{"name", s.name},
                           {"metric", metricName(s.metric)},
                           {"level", s.level},
+                          {"exact_drr", s.exactDrr},
                           {"pixels", std::move(pixels)},
                           {"search", std::move(search)}});
   }

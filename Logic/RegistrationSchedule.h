@@ -35,6 +35,9 @@ struct PixelSetSpec {
   PixelSetKind kind = PixelSetKind::WholeImage;
   int windowSize = 7;            ///< w, pixels of the stage's level (ROIs, and VLNC windows of a whole image)
   double targetFraction = 0.12;  ///< ROIs: fraction of the valid pixels kept (0 < f <= 1; the paper: 0.10-0.15)
+  /// Whole-image NCC/GC sets: at most this many pixels per view, by keeping every k-th column and row (k as small as
+  /// fits); 0 = no cap. A large detector's coarse level then costs like a small one's (VLNC and ROI sets ignore it).
+  int maxPixels = 0;
 };
 
 /// One stage of the schedule. Option units follow the optimizers: scaled units (about 1 mm of bone-surface motion),
@@ -43,6 +46,9 @@ struct RegistrationStage {
   std::string name;
   SimilarityMetric metric = SimilarityMetric::Ncc;
   int level = 0;                   ///< pyramid level: 0 = full resolution, 2 = 1:16 pixels
+  /// Render with the case's exact renderer even when it has per-view Transgraphs (whose interpolation smooths detail
+  /// finer than the table spacing: measured too coarse for the full-resolution stage, see README).
+  bool exactDrr = false;
   PixelSetSpec pixels;
   SearchStrategy search = SearchStrategy::Local;
   int maxEvaluations = 1000;       ///< cap on DRR sets (one per view) of the stage's search
@@ -51,13 +57,16 @@ struct RegistrationStage {
   NelderMeadOptions simplex;       ///< the local search: alone (Local) or inside each genetic guess
 };
 
-/// Ablation switches: each one true turns a technique of the paper off (defaults: everything on).
+/// Ablation switches: each one true turns a technique of the paper off (defaults: everything on). The five techniques
+/// of the paper are dynamic ROIs, the pyramid, the Transgraph, NCC -> VLNC and the genetic search (localOnly);
+/// noTransgraph acts on the case's renderers (Registration), the others on the stages (withAblation).
 struct RegistrationAblation {
   bool noDynamicRois = false;      ///< ROIs -> every valid pixel (VLNC: every complete window)
   bool noPyramid = false;          ///< every stage at level 0
   bool nccOnly = false;            ///< NCC in every stage (no switch to VLNC)
   bool localOnly = false;          ///< every global search replaced by the local simplex
   bool cmaesForGenetic = false;    ///< CMA-ES wherever the schedule says genetic
+  bool noTransgraph = false;       ///< exact (Siddon) DRRs instead of the per-view Transgraphs (transgraph method)
 
   /// Names of the switches that are on, for reports ("no-rois", "no-pyramid", ...).
   std::vector<std::string> activeNames() const;

@@ -33,7 +33,7 @@ echo "== 4. a start pose 10 mm (mean bone-surface distance) away from the truth,
 "$BIN/fluoroct" pose --ct phantom.nrrd --from truth_pose.json --random-offset-mm 10 --seed 3 --out start_pose.json
 
 echo "== 5. registration: NCC then VLNC, dynamic ROIs, pyramid, genetic search (fast preset)"
-"$BIN/fluoroct" register --ct phantom.nrrd --views case/views.json --init start_pose.json --preset fast --no-fov \
+"$BIN/fluoroct" register --ct phantom.nrrd --views case/views.json --init start_pose.json --preset fast \
   --truth truth_pose.json --out result.json --overlays overlays
 
 echo "== 6. DRRs at the registered pose, exact (Siddon) and from the Transgraph ray table"

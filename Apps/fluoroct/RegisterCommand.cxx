@@ -39,6 +39,8 @@ struct Options {
   std::string preset = "paper";
   std::uint32_t seed = 1;
   std::string method = "siddon";
+  std::string transgraphCache;  ///< empty = the default cache folder; "none" = no cache
+  double transgraphSpacing_mm = TransgraphParameters{}.spacing_mm;
   std::string out;
   std::string overlays;
   std::string truth;  ///< optional known true pose (simulated cases): the pose error is reported
@@ -118,7 +120,8 @@ Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const O
   return std::make_pair(e.T_world_from_ct, std::move(source));
 }
 
-nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o, nlohmann::ordered_json initial) {
+nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o, nlohmann::ordered_json initial,
+                                  nlohmann::ordered_json transgraph) {
   nlohmann::ordered_json stages = nlohmann::ordered_json::array();
   for (const StageReport& s : r.stages) {
     nlohmann::ordered_json kept = nlohmann::ordered_json::object();
@@ -129,6 +132,7 @@ nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o,
                       {"search", s.search},
                       {"seconds", s.seconds},
                       {"drrs", s.drrs},
+                      {"fallback_rays", s.fallbackRays},
                       {"evaluations", s.evaluations},
                       {"start_similarity", s.startSimilarity},
                       {"similarity", s.similarity},
@@ -143,6 +147,7 @@ nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o,
       {"stages", std::move(stages)},
       {"total_seconds", r.totalSeconds},
       {"total_drrs", r.totalDrrs},
+      {"transgraph", std::move(transgraph)},
       {"rotation_centre_ct_mm", JsonDocument::array(r.rotationCentre_ct_mm)},
       {"options",
        {{"ct", o.ct},
@@ -212,10 +217,47 @@ int runRegister(const Options& o) {
   }
   RegistrationCaseOptions caseOptions;
   caseOptions.drr.method = method.value();
+  caseOptions.drr.transgraph.spacing_mm = o.transgraphSpacing_mm;
+  if (o.transgraphCache == "none") {
+    caseOptions.drr.transgraphCacheFolder = std::nullopt;
+  } else {
+    caseOptions.drr.transgraphCacheFolder = fs::path(o.transgraphCache);
+  }
+  // The tables are built around the initial pose, unless the Transgraph is switched off for this run.
+  if (!o.ablation.noTransgraph) caseOptions.T_expected_world_from_ct = initial.value().first;
   caseOptions.preparation.detectFieldOfView = !o.noFieldOfView;
-  auto registrationCase = RegistrationCase::create(ct.value(), views, caseOptions);
-  if (!registrationCase) return reportError(registrationCase.error());
+  g_cancel = false;
+  const auto previousHandler = std::signal(SIGINT, onInterrupt);
+  ProgressMonitor::Callback onTableProgress;
+  if (o.progress) {
+    onTableProgress = [](const ProgressUpdate& u) {
+      fmt::print(stderr, "\r{}: {:3.0f}% {:<40}", u.stage, 100.0 * u.fraction, u.message);
+    };
+  }
+  auto registrationCase =
+      RegistrationCase::create(ct.value(), views, caseOptions, ProgressMonitor(onTableProgress, &g_cancel));
+  if (onTableProgress && caseOptions.drr.method == DrrMethod::Transgraph) fmt::print(stderr, "\n");
+  if (!registrationCase) {
+    std::signal(SIGINT, previousHandler);
+    return reportError(registrationCase.error());
+  }
   for (const std::string& warning : registrationCase.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  nlohmann::ordered_json transgraphJson = nullptr;
+  if (registrationCase.value().transgraph(0)) {
+    transgraphJson = {{"setup_seconds", registrationCase.value().viewRendererSetupSeconds()}, {"views", nlohmann::ordered_json::object()}};
+    for (std::size_t v = 0; v < registrationCase.value().viewCount(); ++v) {
+      const Transgraph& table = registrationCase.value().transgraph(v)->transgraph();
+      transgraphJson["views"][registrationCase.value().viewName(v)] = {
+          {"rays", table.rayCount()},
+          {"memory_bytes", table.memory_bytes()},
+          {"seconds", table.buildInfo().build_s},
+          {"loaded_from_cache", table.buildInfo().loadedFromCache},
+          {"cache_file", table.buildInfo().cacheFile.string()}};
+      fmt::print("transgraph {:<10} {:6.1f} M rays, {:5.0f} MB, {} in {:.2f} s\n", registrationCase.value().viewName(v),
+                 table.rayCount() / 1e6, table.memory_bytes() / 1e6,
+                 table.buildInfo().loadedFromCache ? "loaded from the cache" : "built", table.buildInfo().build_s);
+    }
+  }
 
   RegistrationOptions options;
   options.schedule = schedule.value();
@@ -224,8 +266,6 @@ int runRegister(const Options& o) {
   ProgressBar bar;
   RegistrationProgressCallback onProgress;
   if (o.progress) onProgress = [&bar](const RegistrationProgress& p) { bar.update(p); };
-  g_cancel = false;
-  const auto previousHandler = std::signal(SIGINT, onInterrupt);
   auto result = Registration::run(registrationCase.value(), initial.value().first, options, onProgress, &g_cancel);
   std::signal(SIGINT, previousHandler);
   bar.finish();
@@ -244,7 +284,7 @@ int runRegister(const Options& o) {
       if (!written) return reportError(fmt::format("overlay of view '{}': {}", view.name, written.error()));
     }
   }
-  nlohmann::ordered_json json = resultJson(r, o, initial.value().second);
+  nlohmann::ordered_json json = resultJson(r, o, initial.value().second, std::move(transgraphJson));
   std::string errorLine;
   if (T_truth && registrationCase.value().bone()) {
     // The pose error as the paper measures it: mean (max) distance of the bone surface points, final vs. truth.
@@ -263,8 +303,9 @@ int runRegister(const Options& o) {
     if (!written) return reportError(written.error());
   }
   for (const StageReport& s : r.stages) {
-    fmt::print("stage {:<16} {:>4} level {} {:<7} {:7.2f} s {:7} DRRs  similarity {:.4f} -> {:.4f}{}\n", s.name,
+    fmt::print("stage {:<16} {:>4} level {} {:<7} {:7.2f} s {:7} DRRs  similarity {:.4f} -> {:.4f}{}{}\n", s.name,
                s.metric, s.level, s.search, s.seconds, s.drrs, s.startSimilarity, s.similarity,
+               s.fallbackRays ? fmt::format("  ({} rays outside the Transgraph, exact)", s.fallbackRays) : "",
                s.cancelled ? " (cancelled)" : "");
   }
   fmt::print("{} in {:.2f} s, {} DRRs ({} method){}\n", r.cancelled ? "cancelled" : "registered", r.totalSeconds,
@@ -293,7 +334,15 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--preset", options->preset, "Schedule: 'paper', 'fast' or a preset JSON file")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the random searches")->capture_default_str();
-  command->add_option("--method", options->method, "DRR method: siddon, raycast (or any method the build offers)")
+  command->add_option("--method", options->method,
+                      "DRR method: siddon (exact), raycast (trilinear) or transgraph (one precomputed ray table per "
+                      "view around the initial pose, cached on disk; rays outside it are exact)")
+      ->capture_default_str();
+  command->add_option("--transgraph-cache", options->transgraphCache,
+                      "Folder of the transgraph table cache (default: $XDG_CACHE_HOME/fluoroct/transgraph or "
+                      "~/.cache/fluoroct/transgraph); 'none' disables the cache");
+  command->add_option("--transgraph-spacing-mm", options->transgraphSpacing_mm,
+                      "Transgraph ray sampling step on the planes, mm (offsets 3x; rays grow as spacing^-4)")
       ->capture_default_str();
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
   command->add_option("--truth", options->truth,
@@ -303,12 +352,14 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                       "(green) pose over the X-ray");
   command->add_flag("--progress", options->progress, "Show a live progress bar on stderr");
   command->add_flag("--no-fov", options->noFieldOfView,
-                    "Skip the field-of-view (collimator) detection, e.g. for simulated X-rays without a collimator");
+                    "Skip the field-of-view (collimator) detection (use every pixel but the margin band)");
   command->add_flag("--no-rois", options->ablation.noDynamicRois, "Ablation: every valid pixel instead of dynamic ROIs");
   command->add_flag("--no-pyramid", options->ablation.noPyramid, "Ablation: full resolution in every stage");
   command->add_flag("--ncc-only", options->ablation.nccOnly, "Ablation: NCC in every stage (no VLNC)");
   command->add_flag("--local-only", options->ablation.localOnly, "Ablation: local simplex instead of global search");
   command->add_flag("--cmaes", options->ablation.cmaesForGenetic, "CMA-ES instead of the genetic search");
+  command->add_flag("--no-transgraph", options->ablation.noTransgraph,
+                    "Ablation: exact (Siddon) DRRs instead of the Transgraph tables (no table is built)");
   command->callback([&action, options] { action = [options] { return runRegister(*options); }; });
 }
 

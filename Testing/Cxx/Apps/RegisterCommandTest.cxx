@@ -126,6 +126,43 @@ TEST(RegisterCommand, EstimatesTheInitialPoseFromLandmarks) {
   EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 0.5);
 }
 
+TEST(RegisterCommand, RegistersWithTransgraphTablesCachedForTheNextRun) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
+  const std::string command = fmt::format(
+      "register --ct '{}' --views '{}' --init '{}' --preset fast --method transgraph --transgraph-cache '{}' "
+      "--transgraph-spacing-mm 5 --out '{}'",
+      (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(),
+      (dir / "cache").string(), (dir / "result.json").string());
+  auto run = fct::test::runCli(command);
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("built in"), std::string::npos) << run.out;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "cache"), fs::directory_iterator{}), 3) << "one table per view";
+  run = fct::test::runCli(command);
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("loaded from the cache"), std::string::npos) << run.out;
+
+  auto result = fct::JsonDocument::parse(dir / "result.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  const auto& json = result.value();
+  EXPECT_EQ(json["options"]["method"], "transgraph");
+  EXPECT_TRUE(json["transgraph"]["views"]["lateral"]["loaded_from_cache"].get<bool>());
+  for (const auto& stage : json["stages"]) EXPECT_EQ(stage["fallback_rays"], 0) << stage["name"];
+  auto registered = fct::PoseFile::read(dir / "result.json");
+  ASSERT_TRUE(registered.ok()) << registered.error();
+  EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 0.5);
+
+  // The ablation switch: exact DRRs, no table needed.
+  run = fct::test::runCli(command + " --no-transgraph --local-only");
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  result = fct::JsonDocument::parse(dir / "result.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  EXPECT_EQ(result.value()["options"]["method"], "siddon");
+  EXPECT_TRUE(result.value()["transgraph"].is_null());
+  EXPECT_EQ(result.value()["options"]["ablation"][1], "no-transgraph");
+}
+
 TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
   const fs::path dir = fct::test::scratchDir();
   const Eigen::Isometry3d truth = makeCase(dir);

@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "FieldOfViewDetector.h"
+#include "RegistrationTestCase.h"
+#include "VolumeFileIO.h"
 #include "TestSupport.h"
 #include "TestXrayLoader.h"
 
@@ -61,6 +64,39 @@ TEST(FieldOfViewDetector, FullyExposedImageIsAllField) {
   EXPECT_EQ(fov.value().mask.validCount(), 64u * 64u);
 }
 
+TEST(FieldOfViewDetector, SimulatedViewWithBoneReachingTheBorderIsAllField) {
+  // A collimator-free simulated view: I = I0 exp(-line integral) of a dense body cut by the left image border, so
+  // its darkest pixels touch the border and fade smoothly into the exposed area, plus a little noise.
+  fct::FloatImage image = fct::FloatImage::filled(200, 160);
+  for (int r = 0; r < 160; ++r) {
+    for (int c = 0; c < 200; ++c) {
+      const double inside = 1.0 - std::pow((c + 20.0) / 90.0, 2) - std::pow((r - 80.0) / 70.0, 2);
+      const double lineIntegral = 6.0 * std::sqrt(std::max(0.0, inside));
+      image.at(c, r) = static_cast<float>(1000.0 * std::exp(-lineIntegral) + 3.0 * std::sin(1.7 * c + 2.3 * r));
+    }
+  }
+  const auto fov = fct::FieldOfViewDetector().detect(image);
+  ASSERT_TRUE(fov.ok()) << fov.error();
+  EXPECT_FALSE(fov.value().circle.has_value());
+  EXPECT_LT(fov.value().edgeStep, 2.0);
+  EXPECT_EQ(fov.value().mask.validCount(), 200u * 160u) << "the dark bone at the border is not background";
+  EXPECT_EQ(fov.value().backgroundFraction, 0.0);
+}
+
+TEST(FieldOfViewDetector, SimulatedLateralPelvisIsAllField) {
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  auto ct = fct::VolumeFileIO::read(fct::test::dataDir() / "ct/pelvis_totalseg.nii.gz");
+  ASSERT_TRUE(ct.ok()) << ct.error();
+  auto simulated = fct::test::simulateCase(std::move(ct).value());
+  ASSERT_TRUE(simulated.ok()) << simulated.error();
+  for (const fct::RegistrationView& view : simulated.value().views) {
+    const auto fov = fct::FieldOfViewDetector().detect(fct::FloatImage{view.xray.cols, view.xray.rows, view.xray.pixels});
+    ASSERT_TRUE(fov.ok()) << fov.error();
+    EXPECT_FALSE(fov.value().circle.has_value()) << view.name;
+    EXPECT_EQ(fov.value().mask.validCount(), view.xray.pixels.size()) << view.name;
+  }
+}
+
 TEST(FieldOfViewDetector, RejectsTinyBlankAndNonFiniteImages) {
   const fct::FieldOfViewDetector detector;
   EXPECT_FALSE(detector.detect(fct::FloatImage::filled(2, 2, 1.0f)).ok());
@@ -69,6 +105,7 @@ TEST(FieldOfViewDetector, RejectsTinyBlankAndNonFiniteImages) {
   withNaN.at(4, 4) = std::nanf("");
   EXPECT_FALSE(detector.detect(withNaN).ok());
   EXPECT_FALSE(fct::FieldOfViewDetector({1.5, 0.01, 2.0, 3}).detect(fct::FloatImage::filled(16, 16, 1.0f)).ok());
+  EXPECT_FALSE(fct::FieldOfViewDetector({0.1, 0.01, 2.0, 3, 0, 2.0}).detect(fct::FloatImage::filled(16, 16, 1.0f)).ok());
 }
 
 TEST(FieldOfViewDetector, FindsCircularFieldOfRealShoulderFluoroscopy) {
@@ -87,6 +124,7 @@ TEST(FieldOfViewDetector, FindsCircularFieldOfRealShoulderFluoroscopy) {
   EXPECT_NEAR(circle.centre_px.x(), 255.5, 5.0);
   EXPECT_NEAR(circle.centre_px.y(), 231.5, 10.0);
   EXPECT_NEAR(circle.radius_px, 256.0, 8.0);
+  EXPECT_GE(fov.value().edgeStep, 2.0) << "a real field edge is a step";
   // Every black (background) pixel is excluded.
   for (std::size_t i = 0; i < xray->pixels.size(); ++i) {
     if (xray->pixels[i] == 0.0f) {

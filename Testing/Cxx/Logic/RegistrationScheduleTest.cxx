@@ -82,6 +82,8 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "rois", "window": 1}, )" + search + "]}",
        "window"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "all"}, )" + search + "]}", "set"},
+      {stageHead + R"("metric": "ncc", "level": 0, "exact_drr": "yes", "pixels": {"set": "whole"}, )" + search + "]}",
+       "exact_drr"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}})" + "]}", "search"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "local", )" +
            R"("max_evaluations": 10, "simplex": {"tolerance": -1}}}]})",
@@ -113,6 +115,15 @@ TEST(RegistrationSchedule, AblationTurnsOneTechniqueOffAtATime) {
   rois.noDynamicRois = true;
   EXPECT_EQ(paper.withAblation(rois).stages[2].pixels.kind, fct::PixelSetKind::WholeImage);
   EXPECT_EQ(paper.withAblation(rois).stages[2].level, 0);
+
+  // The Transgraph switch acts on the renderers (Registration), not on the stages: only the name changes.
+  fct::RegistrationAblation transgraph;
+  transgraph.noTransgraph = true;
+  EXPECT_EQ(transgraph.activeNames(), std::vector<std::string>{"no-transgraph"});
+  EXPECT_EQ(paper.withAblation(transgraph).toJson()["stages"], paper.toJson()["stages"]);
+  EXPECT_NE(paper.withAblation(transgraph).name.find("no-transgraph"), std::string::npos);
+  EXPECT_TRUE(paper.stages.back().exactDrr) << "the full-resolution stage renders exactly";
+  EXPECT_FALSE(paper.stages.front().exactDrr);
 }
 
 TEST(RegistrationSchedule, RoiPixelsReplaceEveryRoiStagesWindowAndFractionOnly) {

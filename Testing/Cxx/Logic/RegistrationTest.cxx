@@ -7,6 +7,7 @@
 
 #include "PhantomBuilder.h"
 #include "Registration.h"
+#include "RegistrationObjective.h"
 #include "RegistrationTestCase.h"
 #include "TestSupport.h"
 #include "VolumeFileIO.h"
@@ -83,11 +84,9 @@ TEST(Registration, FastPresetRecoversPelvisPoseFrom10mm) {
   ASSERT_TRUE(ct.ok()) << ct.error();
   auto simulated = fct::test::simulateCase(std::move(ct).value());
   ASSERT_TRUE(simulated.ok()) << simulated.error();
-  // The simulated X-rays have no collimator; the pelvis fills the lateral view up to the image border, where the
-  // field-of-view detector would take its darkest band for a border region.
-  fct::RegistrationCaseOptions caseOptions;
-  caseOptions.preparation.detectFieldOfView = false;
-  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, caseOptions);
+  // The pelvis fills the lateral view up to the image border; the field-of-view detector sees no collimator edge there
+  // and keeps the whole image (FieldOfViewDetectorTest).
+  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views);
   ASSERT_TRUE(registrationCase.ok()) << registrationCase.error();
   Prepared p{std::move(simulated).value(), std::move(registrationCase).value()};
   // Fewer starts than the phantom to bound the CI time (see README); the same criterion per start.
@@ -155,6 +154,26 @@ TEST(Registration, EachAblationSwitchStillRuns) {
   }
 }
 
+TEST(RegistrationObjective, WholeImageSetKeepsAtMostMaxPixelsOnARegularGrid) {
+  Prepared p = preparePhantom({}, coarseDetector());
+  fct::RegistrationStage stage = fastOptions().schedule.stages.front();
+  stage.level = 1;  // 64x64 pixels
+  stage.pixels.maxPixels = 0;
+  auto all = fct::RegistrationObjective::create(p.registrationCase, stage);
+  stage.pixels.maxPixels = 1500;
+  auto capped = fct::RegistrationObjective::create(p.registrationCase, stage);
+  ASSERT_TRUE(all.ok() && capped.ok()) << all.error() << capped.error();
+  for (std::size_t v = 0; v < 3; ++v) {
+    const std::size_t n = all.value().renderedPixelCounts()[v];
+    const std::size_t kept = capped.value().renderedPixelCounts()[v];
+    EXPECT_GT(n, 3000u);
+    EXPECT_LE(kept, 1500u);
+    EXPECT_GE(kept, n / 9) << "the smallest stride that fits (2 here)";
+  }
+  const double similarity = capped.value().similarity(p.simulated.T_truth).value();
+  EXPECT_GT(similarity, 0.9) << "the subsampled NCC still sees the match";
+}
+
 TEST(Registration, OtherDrrMethodsRegisterToo) {
   // The DRR method is only an option of the case: the trilinear ray caster registers as well as Siddon.
   fct::RegistrationCaseOptions caseOptions;
@@ -166,20 +185,6 @@ TEST(Registration, OtherDrrMethodsRegisterToo) {
   ASSERT_TRUE(result.ok()) << result.error();
   EXPECT_EQ(result.value().drrMethod, "raycast");
   EXPECT_LT(errorOf(p, result.value().T_world_from_ct), 1.0);
-}
-
-TEST(Registration, TransgraphMethodIsRefusedClearlyUntilPerViewTablesExist) {
-  fct::RegistrationCaseOptions caseOptions;
-  caseOptions.drr.method = fct::DrrMethod::Transgraph;
-  const fct::Volume ct = fct::Volume::create({8, 8, 8}, {1, 1, 1}).value();
-  fct::XrayImage xray;
-  xray.cols = 4;
-  xray.rows = 4;
-  xray.pixels.assign(16, 1.0f);
-  const fct::Camera camera = fct::Camera::lookingAt(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 500, 1000, 4, 4, 1.0);
-  const auto created = fct::RegistrationCase::create(ct, {fct::RegistrationView{"ap", xray, camera, {}}}, caseOptions);
-  ASSERT_FALSE(created.ok());
-  EXPECT_NE(created.error().find("use --method siddon or raycast"), std::string::npos) << created.error();
 }
 
 TEST(Registration, CancelMidStageReturnsBestPoseSoFarMarkedCancelled) {
