@@ -13,6 +13,7 @@
 #include "DrrRendererFactory.h"
 #include "FloatImage.h"
 #include "Result.h"
+#include "SimulatedCaseWriter.h"
 #include "ViewFile.h"
 #include "Volume.h"
 
@@ -24,15 +25,6 @@ struct XraySimulationOptions {
   double unattenuatedIntensity = 60000.0;  ///< I0: detector value of a ray through air (16-bit PNG, headroom for noise)
   double noisePhotons = 0.0;  ///< N: photons per pixel of an unattenuated ray; 0 = noiseless
   std::uint32_t seed = 1;     ///< noise seed; the same seed gives the same images
-};
-
-/// What a simulation wrote.
-struct SimulatedCase {
-  std::vector<ViewSpec> views;           ///< the input views with imagePath set to the written PNGs (absolute)
-  std::filesystem::path viewFile;        ///< DIR/views.json
-  std::filesystem::path poseFile;        ///< DIR/truth_pose.json
-  std::filesystem::path parameterFile;   ///< DIR/simulation.json
-  std::vector<double> maxLineIntegral;   ///< per view: the largest p of its DRR (how dark the darkest pixel is)
 };
 
 /// Simulates fluoroscopic X-ray images from a CT.

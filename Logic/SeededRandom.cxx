@@ -5,6 +5,16 @@
 
 namespace fct {
 
+std::uint32_t SeededRandom::streamSeed(std::uint32_t seed, std::uint32_t stream) {
+  std::uint32_t h = seed * 0x9E3779B9u ^ (stream + 0x7F4A7C15u) * 0x85EBCA6Bu;
+  h ^= h >> 16;
+  h *= 0x7FEB352Du;
+  h ^= h >> 15;
+  h *= 0x846CA68Bu;
+  h ^= h >> 16;
+  return h;
+}
+
 double SeededRandom::uniform01() {
   // 53 random bits from two 32-bit draws, shifted off zero.
   const std::uint64_t high = m_engine() >> 5;  // 27 bits

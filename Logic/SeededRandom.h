@@ -14,6 +14,10 @@ class SeededRandom {
   /// A generator started from `seed`.
   explicit SeededRandom(std::uint32_t seed) : m_engine(seed) {}
 
+  /// The seed of stream `stream` (e.g. an image row) of `seed`: an integer hash, so neighbouring streams get
+  /// unrelated generators and per-row parallel work is reproducible for any thread count.
+  static std::uint32_t streamSeed(std::uint32_t seed, std::uint32_t stream);
+
   /// Uniform in the open interval (0, 1).
   double uniform01();
   /// Uniform in [low, high).
