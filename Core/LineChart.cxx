@@ -63,6 +63,8 @@ cv::Scalar bgr(std::size_t n) {
   return cv::Scalar(c[2], c[1], c[0]);
 }
 
+Result<RgbImage> drawUnguarded(const ChartSpec& spec);
+
 }  // namespace
 
 std::array<std::uint8_t, 3> LineChart::seriesColour(std::size_t n) {
@@ -78,6 +80,16 @@ std::array<std::uint8_t, 3> LineChart::seriesColour(std::size_t n) {
 }
 
 Result<RgbImage> LineChart::draw(const ChartSpec& spec) {
+  try {
+    return drawUnguarded(spec);
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("chart '{}' could not be drawn: {}", spec.title, e.what()));
+  }
+}
+
+namespace {
+
+Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
   if (spec.series.empty()) return fail(fmt::format("chart '{}' has no data series", spec.title));
   if (spec.width_px < 320 || spec.height_px < 240) {
     return fail(fmt::format("chart '{}' is {}x{} pixels; use at least 320x240", spec.title, spec.width_px,
@@ -195,6 +207,8 @@ Result<RgbImage> LineChart::draw(const ChartSpec& spec) {
   cv::cvtColor(image, wrapped, cv::COLOR_BGR2RGB);
   return rgb;
 }
+
+}  // namespace
 
 Status LineChart::writePng(const ChartSpec& spec, const std::filesystem::path& path) {
   auto image = draw(spec);

@@ -50,7 +50,7 @@ std::vector<std::pair<std::string, std::vector<const StudyCondition*>>> groups(c
   return out;
 }
 
-std::string header(const StudyDefinition& study, const std::string& xraySource) {
+std::string header(const StudyDefinition& study, const std::vector<std::string>& notes) {
   std::string text = fmt::format("# Study `{}`{}\n\n{}\n\n", study.name, study.quick ? " (quick)" : "", study.title);
   text += fmt::format("- written {:%Y-%m-%d %H:%M} UTC on a machine with {} hardware threads\n",
                       fmt::gmtime(std::time(nullptr)), std::thread::hardware_concurrency());
@@ -59,7 +59,7 @@ std::string header(const StudyDefinition& study, const std::string& xraySource) 
                       "{} mm; base seed {}\n",
                       study.setup.preset, d.cols, d.rows, d.pixelSpacing_mm, d.sourceToDetector_mm,
                       d.sourceToIsocentre_mm, study.setup.seed);
-  text += fmt::format("- X-rays: {}\n", xraySource);
+  for (const std::string& note : notes) text += "- " + note + "\n";
   text += fmt::format("- success: final mean sTRE < {} mm; sTRE over the CT's bone-surface voxels (>= 250 HU), mTRE over "
                       "a 10x10x10 grid of the bone's bounding box\n\n",
                       PoseErrorMetrics::kSuccessThreshold_mm);
@@ -266,8 +266,8 @@ ConditionStats StudyReport::statistics(const std::vector<TrialRecord>& records) 
 }
 
 std::string StudyReport::markdown(const StudyDefinition& study, const std::vector<TrialRecord>& records,
-                                  const std::string& xraySource) {
-  std::string text = header(study, xraySource);
+                                  const std::vector<std::string>& notes) {
+  std::string text = header(study, notes);
   if (study.name == "table2") {
     text += table2Section(study, records);
   } else if (study.name == "capture") {
@@ -290,7 +290,7 @@ std::string StudyReport::markdown(const StudyDefinition& study, const std::vecto
 
 Result<std::vector<std::filesystem::path>> StudyReport::write(const StudyDefinition& study,
                                                               const std::vector<TrialRecord>& records,
-                                                              const std::string& xraySource,
+                                                              const std::vector<std::string>& notes,
                                                               const std::filesystem::path& outDir) {
   std::vector<std::filesystem::path> written;
   for (const auto& [file, spec] : charts(study, records)) {
@@ -299,7 +299,7 @@ Result<std::vector<std::filesystem::path>> StudyReport::write(const StudyDefinit
     written.push_back(path);
   }
   const std::filesystem::path report = outDir / "report.md";
-  if (Status ok = TextFile::writeAtomically(report, markdown(study, records, xraySource)); !ok) return fail(ok.error());
+  if (Status ok = TextFile::writeAtomically(report, markdown(study, records, notes)); !ok) return fail(ok.error());
   written.push_back(report);
   return written;
 }

@@ -36,15 +36,15 @@ class StudyReport {
  public:
   /// Statistics of `records` (trials of one condition; cancelled ones are ignored).
   static ConditionStats statistics(const std::vector<TrialRecord>& records);
-  /// The Markdown report of `study` from `records` (trials of other studies or conditions are ignored); `xraySource`
-  /// names the forward model used. Lists each failed trial's reason.
+  /// The Markdown report of `study` from `records` (trials of other studies or conditions are ignored); `notes` are
+  /// listed in its header (e.g. the X-ray forward model, StudyRunner::notes). Lists each failed trial's reason.
   static std::string markdown(const StudyDefinition& study, const std::vector<TrialRecord>& records,
-                              const std::string& xraySource);
+                              const std::vector<std::string>& notes);
   /// Writes report.md and the study's charts into `outDir` (existing folder); returns the files written. Fails on an
   /// unwritable folder.
   static Result<std::vector<std::filesystem::path>> write(const StudyDefinition& study,
                                                           const std::vector<TrialRecord>& records,
-                                                          const std::string& xraySource,
+                                                          const std::vector<std::string>& notes,
                                                           const std::filesystem::path& outDir);
 };
 

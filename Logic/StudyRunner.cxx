@@ -125,6 +125,24 @@ Eigen::Isometry3d StudyRunner::truthPose(const BoneSurface& bone) {
   return RigidPose::toTransform(truth, centre_ct_mm);
 }
 
+std::vector<std::string> StudyRunner::notes(const StudyDefinition& study, const std::vector<StudyCt>& cts) {
+  std::vector<std::string> out{"X-rays: " + StudyXraySource::description()};
+  std::set<std::string> said;
+  for (const StudyCondition& c : study.conditions) {
+    const auto ct = std::find_if(cts.begin(), cts.end(), [&](const StudyCt& s) { return s.label == c.ct; });
+    if (ct == cts.end() || c.sliceSpacing_mm <= 0.0 ||
+        StudyXraySource::effectiveSliceSpacing_mm(ct->volume, c.sliceSpacing_mm) > 0.0) {
+      continue;
+    }
+    const std::string key = fmt::format("{}|{}", c.ct, c.sliceSpacing_mm);
+    if (!said.insert(key).second) continue;
+    out.push_back(fmt::format("CT '{}' has {:g} mm slices already, so scenario '{}' ({:g} mm) registers on the original "
+                              "CT",
+                              c.ct, ct->volume.spacing_mm().z(), c.scenario, c.sliceSpacing_mm));
+  }
+  return out;
+}
+
 RegistrationSchedule StudyRunner::scheduleFor(const RegistrationSchedule& base, StudyMeasures measures) {
   RegistrationSchedule schedule = base;
   if (measures == StudyMeasures::Both) return schedule;

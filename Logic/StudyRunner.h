@@ -61,6 +61,9 @@ class StudyRunner {
   /// store cannot be written (the trials so far stay in the file). A registration error is a "failed" trial.
   static Result<StudyRunSummary> run(const StudyDefinition& study, const std::vector<StudyCt>& cts, TrialStore& store,
                                      const StudyRunOptions& options = {});
+  /// Notes for the report: the X-ray forward model, and each condition whose registration CT is the original although
+  /// its scenario asks for coarser slices (the CT's own slices are already that coarse).
+  static std::vector<std::string> notes(const StudyDefinition& study, const std::vector<StudyCt>& cts);
   /// The true pose T_world_from_ct used for a CT with this bone (see the file comment).
   static Eigen::Isometry3d truthPose(const BoneSurface& bone);
   /// `base` with every stage's metric set for `measures` (NCC only, VLNC only, or unchanged).

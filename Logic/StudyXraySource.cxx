@@ -2,51 +2,53 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cmath>
-#include <memory>
 
-#include "DrrRendererFactory.h"
-#include "DrrVolume.h"
-#include "DrrXraySimulator.h"
+#include "CtSliceDegrader.h"
+#include "FluoroscopySimulator.h"
 
 namespace fct {
 
 namespace {
 
-constexpr double kUnattenuatedIntensity = 4000.0;
-constexpr double kMinimumPhotons = 2000.0;   ///< photons per unattenuated pixel, at least
-constexpr double kDarkestPhotons = 20.0;     ///< photons at the darkest pixel (automatic exposure control)
+/// The simulated C-arm: 80 kVp polyenergetic beam, quantum noise, detector blur and vignetting; no distortion,
+/// collimator or foreign objects (those are studied separately).
+FluoroscopyOptions studyOptions() {
+  FluoroscopyOptions o;
+  o.tubeVoltage_kvp = 80.0;
+  o.photonsPerPixel = 10000.0;
+  o.psfSigma_px = 0.7;
+  o.vignetting = 0.1;
+  return o;
+}
 
 }  // namespace
 
 std::string StudyXraySource::description() {
-  return "DrrXraySimulator: Siddon attenuation DRR of the original CT turned into I0 exp(-p) with Poisson noise "
-         "(at least 2000 photons per open pixel, 20 at the darkest); the same ray model as registration's DRRs";
+  const FluoroscopyOptions o = studyOptions();
+  return fmt::format("FluoroscopySimulator on the original CT (exact material path lengths, {:g} kVp spectrum with "
+                     "NIST attenuation, Poisson noise at {:g} photons per open pixel, PSF sigma {:g} px, vignetting "
+                     "{:g}; no distortion, collimator or foreign objects): a forward model independent of "
+                     "registration's DRR",
+                     o.tubeVoltage_kvp, o.photonsPerPixel, o.psfSigma_px, o.vignetting);
 }
 
 Result<std::vector<RegistrationView>> StudyXraySource::simulate(const Volume& ct, const std::vector<ViewSpec>& views,
                                                                 const Eigen::Isometry3d& T_world_from_ct,
                                                                 std::uint32_t seed) {
-  auto drrVolume = DrrVolume::create(ct);
-  if (!drrVolume) return fail("simulation CT: " + drrVolume.error());
-  auto renderer = DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(drrVolume).value()));
-  if (!renderer) return fail(renderer.error());
+  FluoroscopyOptions options = studyOptions();
+  options.seed = seed;
   std::vector<RegistrationView> out;
   for (std::size_t v = 0; v < views.size(); ++v) {
     const ViewSpec& spec = views[v];
-    auto drr = renderer.value()->render(spec.camera, T_world_from_ct, 0);
-    if (!drr) return fail(fmt::format("view '{}': {}", spec.name, drr.error()));
-    const float maxLineIntegral = *std::max_element(drr.value().pixels.begin(), drr.value().pixels.end());
-    const double photons = std::max(kMinimumPhotons, kDarkestPhotons * std::exp(static_cast<double>(maxLineIntegral)));
-    auto intensity = DrrXraySimulator::intensityFromDrr(drr.value(), kUnattenuatedIntensity, photons,
-                                                        seed + static_cast<std::uint32_t>(v));
-    if (!intensity) return fail(fmt::format("view '{}': {}", spec.name, intensity.error()));
+    auto image = FluoroscopySimulator::render(ct, spec.camera, T_world_from_ct, options,
+                                              seed + static_cast<std::uint32_t>(v));
+    if (!image) return fail(fmt::format("view '{}': {}", spec.name, image.error()));
     XrayImage xray;
-    xray.cols = intensity.value().cols;
-    xray.rows = intensity.value().rows;
+    xray.cols = image.value().cols;
+    xray.rows = image.value().rows;
     xray.modality = "simulated";
-    xray.pixels = std::move(intensity.value().pixels);
+    xray.pixels = std::move(image.value().pixels);
     out.push_back(RegistrationView{spec.name, std::move(xray), spec.camera, {}});
   }
   return out;
@@ -56,10 +58,12 @@ Result<Volume> StudyXraySource::registrationCt(const Volume& ct, double sliceSpa
   if (!std::isfinite(sliceSpacing_mm) || sliceSpacing_mm < 0.0) {
     return fail(fmt::format("slice spacing must be 0 (the original CT) or positive, got {} mm", sliceSpacing_mm));
   }
-  if (sliceSpacing_mm == 0.0) return ct;
-  return fail(fmt::format("resampling the CT to {} mm slices needs CtSliceDegrader, which this build does not have; "
-                          "run the 'ideal' scenario only",
-                          sliceSpacing_mm));
+  if (effectiveSliceSpacing_mm(ct, sliceSpacing_mm) == 0.0) return ct;
+  return CtSliceDegrader::degrade(ct, sliceSpacing_mm);
+}
+
+double StudyXraySource::effectiveSliceSpacing_mm(const Volume& ct, double sliceSpacing_mm) {
+  return sliceSpacing_mm > ct.spacing_mm().z() ? sliceSpacing_mm : 0.0;
 }
 
 }  // namespace fct

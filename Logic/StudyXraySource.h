@@ -25,9 +25,13 @@ class StudyXraySource {
   /// with noise seed `seed + n`. Fails, naming the view, on a rendering or simulation error.
   static Result<std::vector<RegistrationView>> simulate(const Volume& ct, const std::vector<ViewSpec>& views,
                                                         const Eigen::Isometry3d& T_world_from_ct, std::uint32_t seed);
-  /// The CT registration sees: `ct` itself for a slice spacing of 0, else `ct` resampled to that slice spacing (mm)
-  /// with the matching slice-thickness blur. Fails on a negative or non-finite spacing or a resampling error.
+  /// The CT registration sees: `ct` resampled to `sliceSpacing_mm` along its slice axis with the matching
+  /// slice-thickness blur (CtSliceDegrader), or `ct` itself when effectiveSliceSpacing_mm() is 0. Fails on a negative
+  /// or non-finite spacing or a resampling error.
   static Result<Volume> registrationCt(const Volume& ct, double sliceSpacing_mm);
+  /// The slice spacing registrationCt() resamples to: `sliceSpacing_mm` if it is above the CT's own slice spacing,
+  /// else 0 (the original CT is used: its slices are already that coarse, or 0 was asked).
+  static double effectiveSliceSpacing_mm(const Volume& ct, double sliceSpacing_mm);
 };
 
 }  // namespace fct

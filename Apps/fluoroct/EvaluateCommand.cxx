@@ -18,7 +18,6 @@
 #include "StudyCatalog.h"
 #include "StudyReport.h"
 #include "StudyRunner.h"
-#include "StudyXraySource.h"
 #include "TrialStore.h"
 
 namespace fct::cli {
@@ -154,7 +153,7 @@ int runEvaluate(const EvaluateOptions& o) {
   std::signal(SIGINT, previousHandler);
   if (!summary) return reportError(summary.error());
 
-  auto written = StudyReport::write(study.value(), store.value().records(), StudyXraySource::description(), o.out);
+  auto written = StudyReport::write(study.value(), store.value().records(), StudyRunner::notes(study.value(), cts.value()), o.out);
   if (!written) return reportError(written.error());
   std::vector<std::string> names;
   for (const fs::path& path : written.value()) names.push_back(path.filename().string());
