@@ -33,6 +33,7 @@ struct RenderedView {
   std::vector<CalibrationSphere> spheres;   ///< shadows of the calibration spheres (observed pixels)
   std::optional<DisplacementField> field;   ///< when distorted
   double maxLineIntegral = 0.0;             ///< -ln of the smallest noiseless signal inside the collimator
+  double referenceSignal = 1.0;             ///< noiseless signal mapped to `gain` (1 = an unattenuated ray)
 };
 
 SpectrumOptions spectrumOptions(const FluoroscopyOptions& o) {
@@ -123,45 +124,74 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
     energyNorm += energyWeight[b];
   }
 
+  // Pass 1: exact material path integrals and the noiseless signal of every pixel inside the collimator.
   RenderedView view;
   view.image = FloatImage::filled(in.cols, in.rows);
-  std::vector<double> rowMinSignal(in.rows, 1.0);
+  const std::size_t pixelCount = static_cast<std::size_t>(in.cols) * in.rows;
+  std::vector<MassPaths> pixelPaths(pixelCount);
+  std::vector<std::uint8_t> exposed(pixelCount, 0);
+  const auto transmissions = [&](const MassPaths& paths, std::vector<double>& transmission) {
+    double signal = 0.0;
+    for (std::size_t b = 0; b < binCount; ++b) {
+      double attenuation = 0.0;
+      for (int m = 0; m < kMaterialCount; ++m) attenuation += scene.massAttenuation_cm2_per_g[b][m] * paths[m];
+      transmission[b] = std::exp(-attenuation);
+      signal += energyWeight[b] * transmission[b];
+    }
+    return signal / energyNorm;
+  };
+  tbb::parallel_for(0, in.rows, [&](int row) {
+    std::vector<double> transmission(binCount);
+    for (int col = 0; col < in.cols; ++col) {
+      const std::size_t index = static_cast<std::size_t>(row) * in.cols + col;
+      if (collimator_px > 0.0 && (Eigen::Vector2d(col, row) - centre_px).norm() > collimator_px) continue;
+      const Eigen::Vector3d direction_camera =
+          Eigen::Vector3d((col - K(0, 2)) / K(0, 0), (row - K(1, 2)) / K(1, 1), 1.0).normalized();
+      const Eigen::Vector3d direction_ct = R_ct_from_camera * direction_camera;
+      MassPaths& paths = pixelPaths[index];
+      paths = scene.tracer.trace(source_ct, direction_ct);
+      scene.implants.accumulate(source_ct, direction_ct, paths);
+      spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
+      view.image.pixels[index] = static_cast<float>(transmissions(paths, transmission));
+      exposed[index] = 1;
+    }
+  });
+  std::vector<float> field;
+  for (std::size_t index = 0; index < pixelCount; ++index) {
+    if (exposed[index]) field.push_back(view.image.pixels[index]);
+  }
+  if (field.empty()) return fail("the collimator leaves no pixel exposed; raise the collimator radius");
+  view.maxLineIntegral = -std::log(std::max(1e-30, double(*std::min_element(field.begin(), field.end()))));
+  view.referenceSignal = 1.0;
+  if (options.automaticExposure) {
+    const auto reference = field.begin() + static_cast<std::ptrdiff_t>(0.99 * double(field.size() - 1));
+    std::nth_element(field.begin(), reference, field.end());
+    if (!(*reference > 1e-30f)) return fail("no X-ray reaches the detector through this CT; check the pose and views");
+    view.referenceSignal = *reference;
+  }
+
+  // Pass 2: exposure scaling and Poisson quantum noise per energy bin.
+  const double photons = options.photonsPerPixel / view.referenceSignal;
   tbb::parallel_for(0, in.rows, [&](int row) {
     SeededRandom random(SeededRandom::streamSeed(viewSeed, static_cast<std::uint32_t>(row)));
     std::vector<double> transmission(binCount);
     for (int col = 0; col < in.cols; ++col) {
-      float& out = view.image.at(col, row);
-      if (collimator_px > 0.0 && (Eigen::Vector2d(col, row) - centre_px).norm() > collimator_px) {
-        out = 0.0f;
+      const std::size_t index = static_cast<std::size_t>(row) * in.cols + col;
+      if (!exposed[index]) continue;
+      float& out = view.image.pixels[index];
+      if (options.photonsPerPixel == 0.0) {
+        out = static_cast<float>(out / view.referenceSignal);
         continue;
       }
-      const Eigen::Vector3d direction_camera =
-          Eigen::Vector3d((col - K(0, 2)) / K(0, 0), (row - K(1, 2)) / K(1, 1), 1.0).normalized();
-      const Eigen::Vector3d direction_ct = R_ct_from_camera * direction_camera;
-      MassPaths paths = scene.tracer.trace(source_ct, direction_ct);
-      scene.implants.accumulate(source_ct, direction_ct, paths);
-      spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
-      double signal = 0.0;
+      transmissions(pixelPaths[index], transmission);
+      double energy = 0.0;
       for (std::size_t b = 0; b < binCount; ++b) {
-        double attenuation = 0.0;
-        for (int m = 0; m < kMaterialCount; ++m) attenuation += scene.massAttenuation_cm2_per_g[b][m] * paths[m];
-        transmission[b] = std::exp(-attenuation);
-        signal += energyWeight[b] * transmission[b];
+        energy += static_cast<double>(random.poisson(photons * photonFraction[b] * transmission[b])) *
+                  scene.spectrum.bins()[b].energy_keV;
       }
-      signal /= energyNorm;
-      rowMinSignal[row] = std::min(rowMinSignal[row], signal);
-      if (options.photonsPerPixel > 0.0) {
-        double energy = 0.0;
-        for (std::size_t b = 0; b < binCount; ++b) {
-          const double expected = options.photonsPerPixel * photonFraction[b] * transmission[b];
-          energy += static_cast<double>(random.poisson(expected)) * scene.spectrum.bins()[b].energy_keV;
-        }
-        signal = energy / (options.photonsPerPixel * energyNorm);
-      }
-      out = static_cast<float>(signal);
+      out = static_cast<float>(energy / (options.photonsPerPixel * energyNorm));
     }
   });
-  view.maxLineIntegral = -std::log(std::max(1e-30, *std::min_element(rowMinSignal.begin(), rowMinSignal.end())));
 
   if (options.psfSigma_px > 0.0) {
     try {
@@ -214,6 +244,7 @@ nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
   j["hu_bone_from"] = o.materials.boneFrom_hu;
   j["hu_cortical_bone"] = o.materials.corticalBone_hu;
   j["hu_metal_from"] = o.materials.metalFrom_hu;
+  j["automatic_exposure"] = o.automaticExposure;
   j["photons_per_pixel"] = o.photonsPerPixel;
   j["psf_sigma_px"] = o.psfSigma_px;
   j["gain"] = o.gain;
@@ -270,6 +301,7 @@ Result<SimulatedCase> FluoroscopySimulator::writeCase(const Volume& ct, const st
     if (!view.ok()) return fail(fmt::format("view '{}': {}", views[n].name, view.error()));
     nlohmann::ordered_json entry{{"name", views[n].name}, {"image", views[n].name + ".png"}, {"seed", viewSeed},
                                  {"max_line_integral", view.value().maxLineIntegral},
+                                 {"exposure_reference_signal", view.value().referenceSignal},
                                  {"calibration_spheres", view.value().spheres.size()}};
     if (view.value().field) {
       const Eigen::Vector2d spacing = views[n].camera.intrinsics().pixelSpacing_mm;
@@ -305,7 +337,7 @@ Result<SimulatedCase> FluoroscopySimulator::writeCase(const Volume& ct, const st
   parameters["distortion_model"] =
       "observed = c + Rot(s * rho^2) * (u - c) * (1 + k * rho^2), rho = |u - c| / (min(cols, rows) / 2), c = detector "
       "centre; field files hold observed - ideal per ideal pixel";
-  parameters["png"] = "16-bit grey, value = offset + gain * (vignetting * signal)^gamma rounded and clamped to "
+  parameters["png"] = "16-bit grey, value = offset + gain * (vignetting * signal / reference)^gamma rounded and clamped to "
                       "0..65535, MONOCHROME2 (bright = more signal)";
   parameters["images"] = perView;
   auto result = SimulatedCaseWriter::write(written, images, extras, T_world_from_ct, parameters, outDir);

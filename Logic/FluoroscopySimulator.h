@@ -12,8 +12,10 @@
 // Poisson quantum noise per energy bin at the given dose, a Gaussian point-spread function, image-intensifier
 // pincushion / S-distortion (IntensifierDistortion), vignetting, and the display transfer gain · s^gamma + offset.
 //
-// Signal s (before vignetting): 1 for a ray through air, Σ_b n_b E_b exp(−Σ_m (µ/ρ)_m(E_b) M_m) / Σ_b n_b E_b
-// without noise. Pixel value (MONOCHROME2, bright = more signal): offset + gain · (v · s)^gamma, v the vignetting.
+// Signal s: 1 for a ray through air, Σ_b n_b E_b exp(−Σ_m (µ/ρ)_m(E_b) M_m) / Σ_b n_b E_b without noise (n_b the
+// bin's photon fraction, M_m the mass per area of material m). Pixel value (MONOCHROME2, bright = more signal):
+// offset + gain · (v · s / s_ref)^gamma, v the vignetting, s_ref the exposure reference (see automaticExposure).
+// With noise, s / s_ref = Σ_b k_b E_b / (N Σ_b n_b E_b), k_b ~ Poisson(N n_b T_b / s_ref), N = photonsPerPixel.
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -40,10 +42,14 @@ struct FluoroscopyOptions {
   double spectrumBinWidth_keV = 5.0;  ///< energy bin width, 1..20 keV
   double monochromatic_keV = 0.0;     ///< > 0: a monochromatic beam at this energy (10..150 keV) instead of the spectrum
   HuMaterialModel materials;          ///< HU -> material densities
-  // Dose and detector.
-  double photonsPerPixel = 0.0;       ///< N0: photons per pixel of an unattenuated ray (all bins); 0 = noiseless
+  // Exposure, dose and detector.
+  /// Automatic exposure (a C-arm's brightness control): the tube output is scaled per view so that the reference
+  /// level — the 99th percentile of the noiseless signal over the exposed pixels — receives photonsPerPixel photons
+  /// and the pixel value `gain`. Off: the reference is an unattenuated ray (s = 1), as for the Beer–Lambert tests.
+  bool automaticExposure = true;
+  double photonsPerPixel = 0.0;       ///< photons per pixel at the reference level (all bins); 0 = noiseless
   double psfSigma_px = 0.0;           ///< Gaussian point-spread function sigma in pixels; 0 = none
-  double gain = 50000.0;              ///< pixel value of an unattenuated ray (s = 1), before offset
+  double gain = 50000.0;              ///< pixel value of the reference level, before offset
   double offset = 0.0;                ///< added to every pixel (dark level)
   double gamma = 1.0;                 ///< display gamma applied to the signal, > 0
   // Image intensifier and collimator.

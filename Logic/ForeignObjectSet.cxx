@@ -129,6 +129,12 @@ Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const
                             options.boneThreshold_hu));
   }
   const Eigen::Vector3d centroid_mm = ct.lpsFromIjk(sum_ijk / boneCount);
+  // Keep the surface near the bone centroid (where the C-arm looks): the nearest half of the surface voxels.
+  const auto distance2 = [&](const Eigen::Vector3i& v) { return (ct.lpsFromIjk(v.cast<double>()) - centroid_mm).squaredNorm(); };
+  const auto middle = surface.begin() + static_cast<std::ptrdiff_t>(surface.size() / 2);
+  std::nth_element(surface.begin(), middle, surface.end(),
+                   [&](const Eigen::Vector3i& a, const Eigen::Vector3i& b) { return distance2(a) < distance2(b); });
+  surface.erase(middle + 1, surface.end());
   SeededRandom random(options.seed);
   const auto surfacePoint = [&] { return ct.lpsFromIjk(surface[random.index(static_cast<int>(surface.size()))].cast<double>()); };
   const auto outward = [&](const Eigen::Vector3d& p_mm) {

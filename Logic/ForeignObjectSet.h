@@ -43,7 +43,7 @@ struct ImplantOptions {
 class ForeignObjectSet {
  public:
   /// K-wires, screws and a plate near the bone of `ct`, in CT LPS mm: each at a random bone-surface voxel (a bone
-  /// voxel with a non-bone 6-neighbour); K-wires point outward (from the bone centroid, ±30° random), tip 25 mm inside;
+  /// voxel with a non-bone 6-neighbour) among the half of them nearest the bone centroid; K-wires point outward (from the bone centroid, ±30° random), tip 25 mm inside;
   /// screws point inward with their head on the surface; the plate lies on the surface, long axis along the CT's
   /// k axis. Deterministic for a seed. Fails on negative counts or, when objects are requested, a CT without bone.
   static Result<ForeignObjectSet> placeNearBone(const Volume& ct, const ImplantOptions& options);

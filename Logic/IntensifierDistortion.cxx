@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 

@@ -1,19 +1,41 @@
-// fluoroct simulate: renders simulated fluoroscopic X-rays (DRRs with optional quantum noise) of a CT at a known pose
-// and writes a ready-to-register case folder (images, view file, true pose, parameters).
+// fluoroct simulate: renders simulated fluoroscopic X-rays of a CT at a known pose — either the registration's own
+// DRR with quantum noise (--model drr) or the physical forward model (--model physical: polyenergetic spectrum,
+// materials, detector and intensifier effects, foreign objects) — and writes a ready-to-register case folder (images,
+// view file, true pose, parameters), optionally with a thick-slice CT for the registration (--ct-slice-mm).
 #include <fmt/core.h>
 
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <memory>
 #include <string>
 #include <system_error>
 
 #include "CliSupport.h"
 #include "CtLoader.h"
+#include "CtSliceDegrader.h"
 #include "DrrXraySimulator.h"
+#include "FluoroscopySimulator.h"
+#include "JsonDocument.h"
 #include "PoseFile.h"
 #include "ViewFile.h"
+#include "VolumeFileIO.h"
 
 namespace fct::cli {
+
+namespace {
+
+/// Options that only the physical model reads.
+constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", "--psf-px",     "--gain",
+                                         "--offset",      "--gamma",            "--pincushion", "--s-distortion-deg",
+                                         "--vignetting",  "--collimator",       "--kwires",     "--screws",
+                                         "--plate",       "--spheres",          "--sphere-pitch-mm",
+                                         "--fixed-exposure"};
+/// Options that only the DRR model reads.
+constexpr const char* kDrrOnly[] = {"--method", "--i0"};
+
+}  // namespace
 
 void registerSimulateCommand(CLI::App& app, CommandAction& action) {
   struct Options {
@@ -21,8 +43,13 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
     std::string views;
     std::string pose;
     std::string out;
+    std::string model = "drr";
     std::string method = "siddon";
-    XraySimulationOptions simulation;
+    double noisePhotons = 0.0;
+    std::uint32_t seed = 1;
+    double ctSlice_mm = 0.0;
+    XraySimulationOptions drr;
+    FluoroscopyOptions physical;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand(
@@ -34,19 +61,80 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       ->required();
   command->add_option("--pose", options->pose, "Pose file with the true T_world_from_ct")->required();
   command->add_option("--out", options->out, "Output folder (created if missing)")->required();
-  command->add_option("--method", options->method, "DRR method: siddon or raycast")->capture_default_str();
-  command->add_option("--noise-photons", options->simulation.noisePhotons,
-                      "Photons per pixel of an unattenuated ray for Poisson noise; 0 = no noise")
+  command->add_option("--model", options->model,
+                      "Forward model: drr (the registration's DRR, I = I0 exp(-p)) or physical (polyenergetic, "
+                      "materials, detector and intensifier effects; independent of the registration's DRR)")
       ->capture_default_str();
-  command->add_option("--seed", options->simulation.seed, "Noise seed")->capture_default_str();
-  command->add_option("--i0", options->simulation.unattenuatedIntensity,
-                      "Image value of an unattenuated ray (I = I0 exp(-p)), at most 65535")
+  command->add_option("--noise-photons,--dose", options->noisePhotons,
+                      "Photons per pixel for Poisson noise (drr: of an unattenuated ray; physical: at the exposure "
+                      "reference level, see --fixed-exposure); 0 = no noise")
       ->capture_default_str();
-  command->callback([&action, options] {
-    action = [options] {
-      auto method = DrrRendererFactory::parseMethod(options->method);
-      if (!method.ok()) return reportError(method.error());
-      options->simulation.method = method.value();
+  command->add_option("--seed", options->seed, "Seed of the noise (view n uses seed + n) and of object placement")
+      ->capture_default_str();
+  command->add_option("--ct-slice-mm", options->ctSlice_mm,
+                      "Also write DIR/ct_registration.nrrd: the CT resampled to this slice spacing with a matching "
+                      "slice-thickness blur (2.4 = the paper's realistic, 4.2 = bad scenario); X-rays use the original")
+      ->capture_default_str();
+  // DRR model.
+  command->add_option("--method", options->method, "drr model: DRR method, siddon or raycast")->capture_default_str();
+  command->add_option("--i0", options->drr.unattenuatedIntensity,
+                      "drr model: image value of an unattenuated ray (I = I0 exp(-p)), at most 65535")
+      ->capture_default_str();
+  // Physical model.
+  FluoroscopyOptions& p = options->physical;
+  command->add_option("--kvp", p.tubeVoltage_kvp, "physical: tube voltage, 50..120 kVp")->capture_default_str();
+  command->add_option("--filtration-mm-al", p.filtration_mmAl, "physical: total tube filtration in mm Al")
+      ->capture_default_str();
+  command->add_flag("--fixed-exposure", [options](std::int64_t) { options->physical.automaticExposure = false; },
+                    "physical: no automatic exposure: --dose and --gain refer to an unattenuated ray instead of the "
+                    "image's 99th-percentile level");
+  command->add_option("--psf-px", p.psfSigma_px, "physical: Gaussian point-spread sigma in pixels")->capture_default_str();
+  command->add_option("--gain", p.gain, "physical: pixel value of an unattenuated ray")->capture_default_str();
+  command->add_option("--offset", p.offset, "physical: dark offset added to every pixel")->capture_default_str();
+  command->add_option("--gamma", p.gamma, "physical: display gamma (value = offset + gain * signal^gamma)")
+      ->capture_default_str();
+  command->add_option("--pincushion", p.pincushion,
+                      "physical: intensifier pincushion k (r' = r (1 + k (r/R)^2)), -0.1..0.1; writes the distortion "
+                      "field as DIR/<view>_distortion_dcol.nrrd and _drow.nrrd")
+      ->capture_default_str();
+  command->add_option("--s-distortion-deg", p.sDistortion_deg, "physical: intensifier S-distortion at r = R, degrees")
+      ->capture_default_str();
+  command->add_option("--vignetting", p.vignetting, "physical: brightness loss at the detector corners, 0..0.9")
+      ->capture_default_str();
+  command->add_option("--collimator", p.collimatorRadiusFraction,
+                      "physical: circular collimator radius as a fraction of half the smaller detector side; 0 = none")
+      ->capture_default_str();
+  command->add_option("--kwires", p.kwireCount, "physical: number of steel K-wires through the bone surface")
+      ->capture_default_str();
+  command->add_option("--screws", p.screwCount, "physical: number of titanium screws into the bone")
+      ->capture_default_str();
+  command->add_flag("--plate", p.plate, "physical: a steel bone plate on the bone surface");
+  command->add_flag("--spheres", p.calibrationSpheres,
+                    "physical: a calibration grid of steel spheres near the detector, listed in views.json");
+  command->add_option("--sphere-pitch-mm", p.sphereSpacing_mm, "physical: calibration grid pitch in mm")
+      ->capture_default_str();
+  command->callback([&action, options, command] {
+    const bool physical = options->model == "physical";
+    std::string misplaced;
+    if (physical) {
+      for (const char* name : kDrrOnly) {
+        if (command->count(name) > 0) misplaced = name;
+      }
+    } else {
+      for (const char* name : kPhysicalOnly) {
+        if (command->count(name) > 0) misplaced = name;
+      }
+    }
+    action = [options, physical, misplaced] {
+      if (options->model != "drr" && options->model != "physical") {
+        return reportError(fmt::format("unknown model '{}'; use drr or physical", options->model));
+      }
+      if (!misplaced.empty()) {
+        return reportError(fmt::format("{} does not apply to --model {}", misplaced, options->model));
+      }
+      if (options->ctSlice_mm < 0.0) {
+        return reportError(fmt::format("--ct-slice-mm must be positive (or 0 for none), got {}", options->ctSlice_mm));
+      }
       auto views = ViewFile::read(options->views);
       if (!views.ok()) return reportError(views.error());
       auto pose = PoseFile::read(options->pose);
@@ -54,15 +142,53 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       auto ct = CtLoader::load(options->ct);
       if (!ct.ok()) return reportError(ct.error());
       for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+      std::optional<Volume> registrationCt;
+      if (options->ctSlice_mm > 0.0) {
+        auto degraded = CtSliceDegrader::degrade(ct.value(), options->ctSlice_mm);
+        if (!degraded.ok()) return reportError(degraded.error());
+        registrationCt = std::move(degraded).value();
+      }
       std::error_code ec;
       const std::filesystem::path ctPath = std::filesystem::absolute(options->ct, ec);
-      auto simulated = DrrXraySimulator::writeCase(ct.value(), views.value(), pose.value(), options->simulation,
-                                                   options->out, ec ? options->ct : ctPath.string());
+      const std::string ctSource = ec ? options->ct : ctPath.string();
+      Result<SimulatedCase> simulated = fail("no model");
+      if (physical) {
+        options->physical.photonsPerPixel = options->noisePhotons;
+        options->physical.seed = options->seed;
+        simulated = FluoroscopySimulator::writeCase(ct.value(), views.value(), pose.value(), options->physical,
+                                                    options->out, ctSource);
+      } else {
+        auto method = DrrRendererFactory::parseMethod(options->method);
+        if (!method.ok()) return reportError(method.error());
+        options->drr.method = method.value();
+        options->drr.noisePhotons = options->noisePhotons;
+        options->drr.seed = options->seed;
+        simulated = DrrXraySimulator::writeCase(ct.value(), views.value(), pose.value(), options->drr, options->out,
+                                                ctSource);
+      }
       if (!simulated.ok()) return reportError(simulated.error());
       for (std::size_t n = 0; n < simulated.value().views.size(); ++n) {
         const ViewSpec& view = simulated.value().views[n];
         fmt::print("wrote {} ({}x{}, max line integral {:.2f})\n", view.imagePath.string(),
                    view.camera.intrinsics().cols, view.camera.intrinsics().rows, simulated.value().maxLineIntegral[n]);
+      }
+      if (registrationCt) {
+        const std::filesystem::path path = std::filesystem::path(options->out) / "ct_registration.nrrd";
+        if (Status written = VolumeFileIO::write(*registrationCt, path); !written) return reportError(written.error());
+        nlohmann::ordered_json document;
+        try {
+          std::ifstream file(simulated.value().parameterFile);
+          document = nlohmann::ordered_json::parse(file);
+        } catch (const nlohmann::json::exception& e) {
+          return reportError(fmt::format("cannot re-read {}: {}", simulated.value().parameterFile.string(), e.what()));
+        }
+        document["registration_ct"] = {{"file", "ct_registration.nrrd"},
+                                       {"slice_spacing_mm", options->ctSlice_mm},
+                                       {"slice_profile", "box of width slice_spacing_mm"}};
+        if (Status written = JsonDocument::write(document, simulated.value().parameterFile); !written) {
+          return reportError(written.error());
+        }
+        fmt::print("wrote {} ({} slices of {} mm)\n", path.string(), registrationCt->dims().z(), options->ctSlice_mm);
       }
       fmt::print("wrote {}, {} and {}\n", simulated.value().viewFile.string(), simulated.value().poseFile.string(),
                  simulated.value().parameterFile.string());
