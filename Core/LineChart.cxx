@@ -143,11 +143,14 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
                 kBlack, 1, cv::LINE_AA);
   }
   if (categorical) {
+    // Names wider than their slot alternate between two rows so neighbours do not overlap.
+    const double slot_px = static_cast<double>(right - left) / static_cast<double>(spec.categories.size());
+    bool stagger = false;
+    for (const std::string& name : spec.categories) stagger = stagger || textSize(name, kTextScale).width > slot_px - 8;
     for (std::size_t i = 0; i < spec.categories.size(); ++i) {
       const int col = px(static_cast<double>(i));
       cv::line(image, cv::Point(col, bottom), cv::Point(col, bottom + 5), kBlack, 1);
-      // Long names alternate between two rows so neighbours do not overlap.
-      centredText(image, spec.categories[i], col, bottom + 20 + (i % 2) * 18, kTextScale);
+      centredText(image, spec.categories[i], col, bottom + 20 + (stagger ? static_cast<int>(i % 2) * 18 : 0), kTextScale);
     }
   } else {
     const double xStep = niceStep(xHi - xLo, 6);
@@ -169,8 +172,10 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
   for (std::size_t n = 0; n < spec.series.size(); ++n) {
     const ChartSeries& s = spec.series[n];
     std::vector<std::pair<double, double>> points;
+    // On a category axis the series sit side by side around each category's tick.
+    const double shift = categorical ? 0.08 * (static_cast<double>(n) - 0.5 * (spec.series.size() - 1.0)) : 0.0;
     for (std::size_t i = 0; i < s.x.size(); ++i) {
-      if (std::isfinite(s.y[i])) points.emplace_back(s.x[i], s.y[i]);
+      if (std::isfinite(s.y[i])) points.emplace_back(s.x[i] + shift, s.y[i]);
     }
     if (s.lines) std::sort(points.begin(), points.end());
     for (std::size_t i = 0; i < points.size(); ++i) {

@@ -27,7 +27,7 @@ FluoroscopyOptions studyOptions() {
 std::string StudyXraySource::description() {
   const FluoroscopyOptions o = studyOptions();
   return fmt::format("FluoroscopySimulator on the original CT (exact material path lengths, {:g} kVp spectrum with "
-                     "NIST attenuation, Poisson noise at {:g} photons per open pixel, PSF sigma {:g} px, vignetting "
+                     "NIST attenuation, automatic exposure, Poisson noise at {:g} photons per pixel at the reference level, PSF sigma {:g} px, vignetting "
                      "{:g}; no distortion, collimator or foreign objects): a forward model independent of "
                      "registration's DRR",
                      o.tubeVoltage_kvp, o.photonsPerPixel, o.psfSigma_px, o.vignetting);

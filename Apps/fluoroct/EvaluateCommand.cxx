@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
@@ -31,6 +32,7 @@ struct EvaluateOptions {
   std::string out;
   bool quick = false;
   int jobs = 1;
+  int trials = 0;  ///< > 0: at most this many trials per condition
   std::vector<std::string> cts;
 };
 
@@ -119,6 +121,7 @@ int runEvaluate(const EvaluateOptions& o) {
   // The study name is checked before anything is loaded (the CT labels are placeholders here).
   if (auto known = StudyCatalog::define(o.study, o.quick, {"ct"}); !known) return reportError(known.error());
   if (o.jobs < 1) return reportError(fmt::format("--jobs must be at least 1, got {}", o.jobs));
+  if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
   if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
   auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
   if (!store) return reportError(store.error());
@@ -132,7 +135,10 @@ int runEvaluate(const EvaluateOptions& o) {
   auto study = StudyCatalog::define(o.study, o.quick, labels);
   if (!study) return reportError(study.error());
   std::size_t total = 0;
-  for (const StudyCondition& c : study.value().conditions) total += static_cast<std::size_t>(c.trials);
+  for (StudyCondition& c : study.value().conditions) {
+    if (o.trials > 0) c.trials = std::min(c.trials, o.trials);
+    total += static_cast<std::size_t>(c.trials);
+  }
   fmt::print(stderr, "evaluate: study '{}'{} on {}: {} conditions, {} trials, {} job(s)\n", o.study,
              o.quick ? " (quick)" : "", fmt::join(labels, ", "), study.value().conditions.size(), total, o.jobs);
 
@@ -153,7 +159,12 @@ int runEvaluate(const EvaluateOptions& o) {
   std::signal(SIGINT, previousHandler);
   if (!summary) return reportError(summary.error());
 
-  auto written = StudyReport::write(study.value(), store.value().records(), StudyRunner::notes(study.value(), cts.value()), o.out);
+  std::vector<std::string> notes = StudyRunner::notes(study.value(), cts.value());
+  notes.insert(notes.begin(), fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}`", o.study,
+                                          o.quick ? " --quick" : "", o.out,
+                                          o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
+                                          o.cts.empty() ? "" : fmt::format(" --ct {}", fmt::join(o.cts, " "))));
+  auto written = StudyReport::write(study.value(), store.value().records(), notes, o.out);
   if (!written) return reportError(written.error());
   std::vector<std::string> names;
   for (const fs::path& path : written.value()) names.push_back(path.filename().string());
@@ -177,6 +188,8 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
   command->add_flag("--quick", options->quick,
                     "Small version on the built-in phantom (fast preset, 192x192 detector, 2 trials per condition)");
   command->add_option("--jobs", options->jobs, "Trials run in parallel")->capture_default_str();
+  command->add_option("--trials", options->trials,
+                      "At most this many trials per condition (a sample of a study; the first N of each condition)");
   command->add_option("--ct", options->cts,
                       "CT volume(s) or DICOM folder(s) instead of the defaults (full: ../shared/data pelvis, plus the "
                       "head phantom for table2; quick: the phantom)");
