@@ -14,8 +14,8 @@ StudySetup setupFor(bool quick) {
   StudySetup setup;
   if (quick) {
     setup.preset = "fast";
-    setup.detector.cols = setup.detector.rows = 192;
-    setup.detector.pixelSpacing_mm = 1.6;
+    setup.detector.cols = setup.detector.rows = 128;
+    setup.detector.pixelSpacing_mm = 2.4;
     setup.detector.sourceToDetector_mm = 1000.0;
     setup.detector.sourceToIsocentre_mm = 700.0;
   }

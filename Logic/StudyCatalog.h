@@ -6,8 +6,8 @@
 // - ablation: the full method, then each technique off in turn (dynamic ROIs, pyramid, NCC->VLNC, genetic search)
 //             and CMA-ES in place of the genetic search (the paper's Table 1, measured); 10 mm starts.
 // - views:    1 to 5 views, 10 mm starts.
-// Full studies use the "paper" preset and an 800 x 600 detector at 0.4 mm; quick ones the "fast" preset, a 192 x 192
-// detector at 1.6 mm and 2 trials per condition (a few minutes in all, for CI).
+// Full studies use the "paper" preset and an 800 x 600 detector at 0.4 mm; quick ones the "fast" preset, a 128 x 128
+// detector at 2.4 mm and 2 trials per condition (a few minutes in all, for CI).
 
 #include <string>
 #include <string_view>

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -67,10 +69,8 @@ Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, c
   return Ok{};
 }
 
-/// Runs one trial on `registrationCase` (a worker's own copy).
-TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const CtScene& scene,
-                     RegistrationCase& registrationCase, const RegistrationSchedule& schedule,
-                     const std::atomic<bool>* cancel) {
+/// The record of a trial that did not register: identification, NaN errors, status "failed" and the reason.
+TrialRecord failedTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const std::string& reason) {
   TrialRecord r;
   r.study = study.name;
   r.ct = c.ct;
@@ -82,12 +82,21 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
   r.seed = study.setup.seed + static_cast<std::uint32_t>(trial);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   r.error = PoseError{nan, nan, nan, nan, nan};
+  r.status = "failed";
+  r.reason = reason;
+  return r;
+}
+
+/// Runs one trial on `registrationCase` (a worker's own copy).
+TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const CtScene& scene,
+                     RegistrationCase& registrationCase, const RegistrationSchedule& schedule,
+                     const std::atomic<bool>* cancel) {
+  TrialRecord r = failedTrial(study, c, trial, "");
 
   SeededRandom random(r.seed ^ 0x5BD1E995u);
   r.initialTarget_mm = c.initialLow_mm + (c.initialHigh_mm - c.initialLow_mm) * random.uniform01();
   auto start = PoseOffset::randomAtSurfaceDistance(scene.metrics->surface(), scene.T_truth, r.initialTarget_mm, r.seed);
   if (!start) {
-    r.status = "failed";
     r.reason = "start pose: " + start.error();
     return r;
   }
@@ -101,10 +110,10 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
   auto result = Registration::run(registrationCase, start.value(), options, {}, cancel);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clockStart).count();
   if (!result) {
-    r.status = "failed";
     r.reason = result.error();
     return r;
   }
+  r.status = "ok";
   r.drrs = result.value().totalDrrs;
   r.error = scene.metrics->measure(result.value().T_world_from_ct, scene.T_truth);
   r.success = PoseErrorMetrics::isSuccess(r.error);
@@ -207,8 +216,9 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
     const std::string key = caseKey(c);
     if (prototypes.count(key)) continue;
     const CtScene& scene = scenes.at(c.ct);
+    const double sliceSpacing_mm = StudyXraySource::effectiveSliceSpacing_mm(*scene.ct, c.sliceSpacing_mm);
     message(fmt::format("preparing registration on CT '{}' ({}) with {} views", c.ct,
-                        c.sliceSpacing_mm > 0 ? fmt::format("{} mm slices", c.sliceSpacing_mm) : "original slices",
+                        sliceSpacing_mm > 0 ? fmt::format("{:g} mm slices", sliceSpacing_mm) : "original slices",
                         c.viewCount));
     auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
     if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
@@ -238,8 +248,13 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
       const std::string key = caseKey(c);
       auto found = ownCases.find(key);
       if (found == ownCases.end()) found = ownCases.emplace(key, *prototypes.at(key)).first;
-      TrialRecord record = runTrial(study, c, pending[i].trial, scenes.at(c.ct), found->second,
-                                    schedules.at(c.measures), options.cancel);
+      TrialRecord record;
+      try {
+        record = runTrial(study, c, pending[i].trial, scenes.at(c.ct), found->second, schedules.at(c.measures),
+                          options.cancel);
+      } catch (const std::exception& e) {  // e.g. out of memory: this trial fails, the study goes on
+        record = failedTrial(study, c, pending[i].trial, fmt::format("unexpected error: {}", e.what()));
+      }
       const std::lock_guard lock(mutex);
       ++summary.ran;
       if (record.status == "failed") ++summary.failed;

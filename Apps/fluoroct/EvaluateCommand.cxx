@@ -186,7 +186,7 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--study", options->study, "Study: table2, capture, ablation or views")->required();
   command->add_option("--out", options->out, "Output folder (re-running with the same folder resumes)")->required();
   command->add_flag("--quick", options->quick,
-                    "Small version on the built-in phantom (fast preset, 192x192 detector, 2 trials per condition)");
+                    "Small version on the built-in phantom (fast preset, 128x128 detector, 2 trials per condition)");
   command->add_option("--jobs", options->jobs, "Trials run in parallel")->capture_default_str();
   command->add_option("--trials", options->trials,
                       "At most this many trials per condition (a sample of a study; the first N of each condition)");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -143,4 +144,21 @@ TEST(EvaluateCommand, BadInputGivesOneErrorLine) {
   const auto jobs = fct::test::runCli(fmt::format("evaluate --study views --quick --jobs 0 --out '{}'", (dir / "j").string()));
   EXPECT_EQ(jobs.exitCode, 2);
   EXPECT_NE(jobs.err.find("--jobs"), std::string::npos) << jobs.err;
+}
+
+TEST(EvaluateCommand, FullStudyWithoutTheSharedDataIsSkippedWithAMessage) {
+  const auto dir = fct::test::scratchDir();
+  const char* previous = std::getenv("FLUOROCT_DATA_DIR");
+  const std::string saved = previous ? previous : "";
+  ::setenv("FLUOROCT_DATA_DIR", (dir / "no-data").c_str(), 1);
+  const auto run = fct::test::runCli(fmt::format("evaluate --study capture --out '{}'", (dir / "out").string()));
+  if (previous) {
+    ::setenv("FLUOROCT_DATA_DIR", saved.c_str(), 1);
+  } else {
+    ::unsetenv("FLUOROCT_DATA_DIR");
+  }
+  EXPECT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.err.find("evaluate: skipped: the full 'capture' study needs"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("pelvis_totalseg.nii.gz"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "trials.csv"));
 }
