@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   registerViewsCommand(app, action);
   registerSimulateCommand(app, action);
   registerRegisterCommand(app, action);
+  registerTreCommand(app, action);
+  registerEvaluateCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
