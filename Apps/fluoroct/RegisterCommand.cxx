@@ -15,8 +15,8 @@
 
 #include "CliSupport.h"
 #include "ContourOverlay.h"
-#include "ImageFileWriter.h"
 #include "CtLoader.h"
+#include "ImageFileWriter.h"
 #include "JsonDocument.h"
 #include "JsonReader.h"
 #include "LandmarkFile.h"
