@@ -37,17 +37,30 @@ Result<PreparedXray> XrayPreparation::prepare(const XrayImage& xray) const {
     sphere.radius_px += o.sphereMargin_px;
     mask.excludeInside(sphere);
   }
-  const std::size_t validCount = mask.validCount();
-  if (validCount == 0) {
+  if (mask.validCount() == 0) {
     return fail(fmt::format("no pixel of the {}x{} X-ray is left after excluding the field-of-view border, a {} px "
                             "margin and {} spheres; reduce the margin or check the image",
                             xray.cols, xray.rows, o.margin_px, prepared.spheres.size()));
   }
-  prepared.validFraction = static_cast<double>(validCount) / static_cast<double>(mask.valid.size());
 
   auto lineIntegrals = XrayIntensityModel(o.intensity).toLineIntegrals(intensities, mask);
   if (!lineIntegrals) return fail("intensity model: " + lineIntegrals.error());
   prepared.referenceIntensity = lineIntegrals.value().referenceIntensity;
+
+  if (o.excludeMetal) {
+    const std::size_t fieldCount = mask.validCount();
+    const double pixelSpacing_mm = xray.camera ? xray.camera->intrinsics().pixelSpacing_mm.mean() : 0.0;
+    auto metal = MetalMaskDetector(o.metal).detect(lineIntegrals.value().lineIntegrals, mask, pixelSpacing_mm);
+    if (!metal) return fail(metal.error());
+    if (metal.value().metalPixelCount == fieldCount) {
+      return fail(fmt::format("every valid pixel of the {}x{} X-ray looks like metal (line integral more than {} above "
+                              "its surroundings); check the image or turn the metal exclusion off",
+                              xray.cols, xray.rows, o.metal.minExcess));
+    }
+    prepared.metalFraction = static_cast<double>(metal.value().metalPixelCount) / static_cast<double>(fieldCount);
+    mask = std::move(metal).value().mask;
+  }
+  prepared.validFraction = static_cast<double>(mask.validCount()) / static_cast<double>(mask.valid.size());
 
   auto pyramid = XrayPyramid::build(lineIntegrals.value().lineIntegrals, mask, xray.camera, o.levelCount);
   if (!pyramid) return fail("pyramid: " + pyramid.error());

@@ -1,6 +1,6 @@
 #pragma once
 // XrayPreparation: turns one X-ray view into what the comparison with the DRR needs: a validity mask (field of view,
-// image margin, calibration spheres, and the image's own fovMask if it has one), the image in the DRR's
+// image margin, calibration spheres, metal shadows, and the image's own fovMask if it has one), the image in the DRR's
 // line-integral sense (XrayIntensityModel), and the pyramid of levels 0..levelCount-1 with their cameras.
 
 #include <optional>
@@ -8,6 +8,7 @@
 
 #include "CalibrationSphereDetector.h"
 #include "FieldOfViewDetector.h"
+#include "MetalMaskDetector.h"
 #include "PixelCircle.h"
 #include "Result.h"
 #include "XrayImage.h"
@@ -26,6 +27,8 @@ struct XrayPreparationOptions {
   CalibrationSphereOptions sphereDetection;   ///< settings of the detection
   double sphereMargin_px = 2.0;               ///< added to each sphere's radius when excluding it
   IntensityModelOptions intensity;            ///< log transform settings
+  bool excludeMetal = true;                   ///< exclude metal shadows (K-wires, screws, plates) found in the image
+  MetalMaskOptions metal;                     ///< settings of the metal detection
   int levelCount = 3;                         ///< pyramid levels: 3 = 1, 1:4, 1:16 pixels
 };
 
@@ -36,6 +39,7 @@ struct PreparedXray {
   std::vector<PixelCircle> spheres;        ///< excluded sphere shadows, given and detected (level 0 px, no margin)
   double referenceIntensity = 0.0;         ///< I0 of the log transform, in the input's intensity units
   double validFraction = 0.0;              ///< fraction of level-0 pixels valid
+  double metalFraction = 0.0;              ///< fraction of the otherwise valid level-0 pixels excluded as metal
 };
 
 /// Prepares X-ray views for registration.

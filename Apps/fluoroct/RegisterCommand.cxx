@@ -16,6 +16,7 @@
 #include "CliSupport.h"
 #include "ContourOverlay.h"
 #include "CtLoader.h"
+#include "ImageFileWriter.h"
 #include "JsonDocument.h"
 #include "JsonReader.h"
 #include "LandmarkFile.h"
@@ -46,6 +47,9 @@ struct Options {
   std::string truth;  ///< optional known true pose (simulated cases): the pose error is reported
   bool progress = false;
   bool noFieldOfView = false;
+  bool noMetalMask = false;
+  double metalMinExcess = MetalMaskOptions{}.minExcess;
+  std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
   RegistrationAblation ablation;
 };
 
@@ -61,6 +65,15 @@ Result<XrayImage> readImage(const ViewSpec& view) {
   auto image = XrayLoader::load(view.imagePath, view.frame);
   if (!image) return fail(fmt::format("view '{}': {}", view.name, image.error()));
   return image;
+}
+
+/// Writes a validity mask as an 8-bit-range PNG (white = compared, black = excluded), creating the folder.
+Status writeMaskPng(const ValidMask& mask, const fs::path& path) {
+  std::error_code ec;
+  fs::create_directories(path.parent_path(), ec);
+  if (ec) return fail(fmt::format("cannot create the mask folder '{}': {}", path.parent_path().string(), ec.message()));
+  FloatImage image{mask.cols, mask.rows, std::vector<float>(mask.valid.begin(), mask.valid.end())};
+  return ImageFileWriter::writePng16(image, path, 0.0f, 1.0f);
 }
 
 /// The initial pose from --init or --landmarks, and a JSON description of where it came from.
@@ -157,6 +170,8 @@ nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o,
         {"method", r.drrMethod},
         {"ablation", o.ablation.activeNames()},
         {"field_of_view_detection", !o.noFieldOfView},
+        {"metal_mask", !o.noMetalMask},
+        {"metal_min_excess", o.metalMinExcess},
         {"schedule", r.schedule.toJson()}}}};
 }
 
@@ -226,6 +241,8 @@ int runRegister(const Options& o) {
   // The tables are built around the initial pose, unless the Transgraph is switched off for this run.
   if (!o.ablation.noTransgraph) caseOptions.T_expected_world_from_ct = initial.value().first;
   caseOptions.preparation.detectFieldOfView = !o.noFieldOfView;
+  caseOptions.preparation.excludeMetal = !o.noMetalMask;
+  caseOptions.preparation.metal.minExcess = o.metalMinExcess;
   g_cancel = false;
   const auto previousHandler = std::signal(SIGINT, onInterrupt);
   ProgressMonitor::Callback onTableProgress;
@@ -258,6 +275,20 @@ int runRegister(const Options& o) {
                  table.buildInfo().loadedFromCache ? "loaded from the cache" : "built", table.buildInfo().build_s);
     }
   }
+  nlohmann::ordered_json metalFractions = nlohmann::ordered_json::object();
+  for (std::size_t v = 0; v < registrationCase.value().viewCount(); ++v) {
+    const PreparedXray& prepared = registrationCase.value().prepared(v);
+    metalFractions[registrationCase.value().viewName(v)] = prepared.metalFraction;
+    if (!o.noMetalMask) {
+      fmt::print("view {}: metal mask excludes {:.2f} % of the field\n", registrationCase.value().viewName(v),
+                 100.0 * prepared.metalFraction);
+    }
+    if (!o.masks.empty()) {
+      const Status written = writeMaskPng(prepared.pyramid.level(0).mask,
+                                          fs::path(o.masks) / (registrationCase.value().viewName(v) + "_mask.png"));
+      if (!written) return reportError(written.error());
+    }
+  }
 
   RegistrationOptions options;
   options.schedule = schedule.value();
@@ -285,6 +316,7 @@ int runRegister(const Options& o) {
     }
   }
   nlohmann::ordered_json json = resultJson(r, o, initial.value().second, std::move(transgraphJson));
+  if (!o.noMetalMask) json["metal_fraction"] = std::move(metalFractions);
   std::string errorLine;
   if (T_truth && registrationCase.value().bone()) {
     // The pose error as the paper measures it: mean (max) distance of the bone surface points, final vs. truth.
@@ -353,6 +385,15 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_flag("--progress", options->progress, "Show a live progress bar on stderr");
   command->add_flag("--no-fov", options->noFieldOfView,
                     "Skip the field-of-view (collimator) detection (use every pixel but the margin band)");
+  command->add_flag("--no-metal-mask", options->noMetalMask,
+                    "Compare metal shadows (K-wires, screws, plates) too instead of excluding them");
+  command->add_option("--metal-min-excess", options->metalMinExcess,
+                      "Line integral a narrow shadow must add over its surroundings to count as metal (-ln of the "
+                      "fraction of signal it passes; physical, log-linear detector images)")
+      ->capture_default_str();
+  command->add_option("--masks", options->masks,
+                      "Folder for one PNG per view (<view>_mask.png): white pixels are compared with the DRR, black "
+                      "ones excluded (field border, margin, calibration spheres, metal)");
   command->add_flag("--no-rois", options->ablation.noDynamicRois, "Ablation: every valid pixel instead of dynamic ROIs");
   command->add_flag("--no-pyramid", options->ablation.noPyramid, "Ablation: full resolution in every stage");
   command->add_flag("--ncc-only", options->ablation.nccOnly, "Ablation: NCC in every stage (no VLNC)");

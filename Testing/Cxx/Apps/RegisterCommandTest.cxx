@@ -58,9 +58,10 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   ASSERT_TRUE(fct::PoseFile::write(truth, dir / "truth.json").ok());
   const auto run = fct::test::runCli(fmt::format(
       "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --out '{}' --progress --overlays '{}' "
-      "--truth '{}'",
+      "--truth '{}' --masks '{}'",
       (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(),
-      (dir / "result.json").string(), (dir / "overlays").string(), (dir / "truth.json").string()));
+      (dir / "result.json").string(), (dir / "overlays").string(), (dir / "truth.json").string(),
+      (dir / "masks").string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("registered"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("stage 1/4"), std::string::npos) << "progress bar on stderr: " << run.err;
@@ -90,8 +91,12 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   EXPECT_EQ(json["options"]["schedule"]["stages"].size(), 4u);
   EXPECT_EQ(json["initial_pose"]["source"], "pose file");
   EXPECT_EQ(json["initial_pose"]["T_world_from_ct"].size(), 4u);
+  EXPECT_TRUE(json["options"]["metal_mask"].get<bool>());
+  EXPECT_NE(run.out.find("view ap: metal mask excludes"), std::string::npos) << run.out;
   for (const char* view : {"ap", "lateral", "oblique45"}) {
     EXPECT_GT(fs::file_size(dir / "overlays" / (std::string(view) + ".png")), 1000u) << view;
+    EXPECT_TRUE(fs::exists(dir / "masks" / (std::string(view) + "_mask.png"))) << view;
+    EXPECT_LT(json["metal_fraction"][view].get<double>(), 0.05) << "the phantom has no metal: " << view;
   }
 }
 
@@ -181,6 +186,10 @@ TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
 
   const auto badMethod = fct::test::runCli(base + init + " --method magic");
   EXPECT_TRUE(oneErrorLine(badMethod)) << badMethod.err;
+
+  const auto badMetal = fct::test::runCli(base + init + " --metal-min-excess 0");
+  EXPECT_TRUE(oneErrorLine(badMetal)) << badMetal.err;
+  EXPECT_NE(badMetal.err.find("minimum excess"), std::string::npos) << badMetal.err;
 
   Eigen::Isometry3d far = truth;
   far.translation().z() += 900.0;

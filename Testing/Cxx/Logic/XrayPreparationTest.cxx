@@ -102,3 +102,37 @@ TEST(XrayPreparation, RejectsInconsistentImagesAndMasksThatLeaveNothing) {
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.error().find("margin"), std::string::npos) << result.error();
 }
+
+TEST(XrayPreparation, ExcludesMetalShadowAndReportsItsFractionUnlessSwitchedOff) {
+  // A smooth bright-to-dark ramp (soft tissue and bone) with a 4 px wide wire passing 3 % of the signal.
+  fct::XrayImage xray;
+  xray.cols = 128;
+  xray.rows = 96;
+  xray.pixels.resize(128u * 96u);
+  for (int row = 0; row < 96; ++row) {
+    for (int col = 0; col < 128; ++col) {
+      float intensity = 3000.0f * std::exp(-0.01f * static_cast<float>(col));
+      if (col >= 60 && col < 64) intensity *= 0.03f;
+      xray.pixels[static_cast<std::size_t>(row) * 128 + col] = intensity;
+    }
+  }
+  fct::XrayPreparationOptions options;
+  options.detectFieldOfView = false;
+  options.margin_px = 2;
+  options.levelCount = 1;
+  const auto prepared = fct::XrayPreparation(options).prepare(xray);
+  ASSERT_TRUE(prepared.ok()) << prepared.error();
+  const fct::ValidMask& mask = prepared.value().pyramid.level(0).mask;
+  EXPECT_FALSE(mask.isValid(61, 48));
+  EXPECT_FALSE(mask.isValid(58, 48)) << "dilated";
+  EXPECT_TRUE(mask.isValid(20, 48));
+  EXPECT_TRUE(mask.isValid(110, 48));
+  const double wireFraction = (4.0 + 2 * 3) / (128.0 - 4);  // wire + 3 px dilation each side, of the field columns
+  EXPECT_NEAR(prepared.value().metalFraction, wireFraction, 1e-9);
+
+  options.excludeMetal = false;
+  const auto kept = fct::XrayPreparation(options).prepare(xray);
+  ASSERT_TRUE(kept.ok()) << kept.error();
+  EXPECT_TRUE(kept.value().pyramid.level(0).mask.isValid(61, 48));
+  EXPECT_EQ(kept.value().metalFraction, 0.0);
+}
