@@ -45,8 +45,9 @@ struct PendingTrial {
   int trial = 0;
 };
 
-std::string caseKey(const StudyCondition& c) {
-  return fmt::format("{}|{}|{}", c.ct, c.sliceSpacing_mm, c.viewCount);
+/// Conditions registering on the same CT (after resampling, if any) with the same views share a case.
+std::string caseKey(const StudyCondition& c, const Volume& ct) {
+  return fmt::format("{}|{}|{}", c.ct, StudyXraySource::effectiveSliceSpacing_mm(ct, c.sliceSpacing_mm), c.viewCount);
 }
 
 Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, const StudyRunOptions& options) {
@@ -244,9 +245,9 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
   std::map<std::string, std::unique_ptr<RegistrationCase>> prototypes;
   for (const PendingTrial& p : pending) {
     const StudyCondition& c = *p.condition;
-    const std::string key = caseKey(c);
-    if (prototypes.count(key)) continue;
     const CtScene& scene = scenes.at(c.ct);
+    const std::string key = caseKey(c, *scene.ct);
+    if (prototypes.count(key)) continue;
     const double sliceSpacing_mm = StudyXraySource::effectiveSliceSpacing_mm(*scene.ct, c.sliceSpacing_mm);
     message(fmt::format("preparing registration on CT '{}' ({}) with {} views", c.ct,
                         sliceSpacing_mm > 0 ? fmt::format("{:g} mm slices", sliceSpacing_mm) : "original slices",
@@ -276,7 +277,7 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
       const std::size_t i = next.fetch_add(1);
       if (i >= pending.size() || storeFailed.load() || cancelled()) return;
       const StudyCondition& c = *pending[i].condition;
-      const std::string key = caseKey(c);
+      const std::string key = caseKey(c, *scenes.at(c.ct).ct);
       auto found = ownCases.find(key);
       if (found == ownCases.end()) {
         found = ownCases.emplace(key, *prototypes.at(key)).first;
