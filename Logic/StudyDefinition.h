@@ -4,9 +4,11 @@
 // detector, simulated dose, seed). StudyCatalog makes the built-in ones; StudyRunner runs them.
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "DrrRendererFactory.h"
 #include "RegistrationSchedule.h"
 #include "StandardViews.h"
 
@@ -25,6 +27,9 @@ struct StudyCondition {
   std::string ct;                 ///< label of the CT (StudyCt::label)
   std::string scenario = "ideal"; ///< "ideal" (registration on the original CT), "realistic", "bad"
   double sliceSpacing_mm = 0.0;   ///< registration CT resampled to this slice spacing (0: the original CT)
+  /// Slice spacing of the registration CT actually used, mm (StudyRunner::resolveSliceSpacings; 0: not resolved yet).
+  /// Equals sliceSpacing_mm, or the CT's own spacing when that is already as coarse (or sliceSpacing_mm is 0).
+  double usedSliceSpacing_mm = 0.0;
   int viewCount = 3;              ///< the first viewCount standard views (StandardViews)
   std::string variant = "full";   ///< technique variant for reports ("full", "no-rois", "ncc-only", ...)
   RegistrationAblation ablation;  ///< techniques switched off
@@ -39,6 +44,11 @@ struct StudySetup {
   std::string preset = "paper";   ///< registration schedule (RegistrationSchedule::resolve)
   StandardViewOptions detector;   ///< C-arm geometry and detector (its count is ignored: conditions choose)
   std::uint32_t seed = 1;         ///< base seed: trial t of every condition starts from seed + t
+  DrrMethod method = DrrMethod::Siddon;  ///< DRR method of the registrations (a condition's ablation may switch the
+                                         ///< Transgraph off)
+  double transgraphSpacing_mm = 3.0;     ///< Transgraph table step (TransgraphParameters::spacing_mm)
+  /// Transgraph table cache folder shared by the trials (empty: no cache, every trial builds its tables).
+  std::filesystem::path transgraphCacheDir;
 };
 
 /// A whole study.

@@ -10,6 +10,7 @@
 #include <map>
 #include <thread>
 
+#include "DrrRendererFactory.h"
 #include "LineChart.h"
 #include "PoseErrorMetrics.h"
 #include "TextFile.h"
@@ -55,10 +56,11 @@ std::string header(const StudyDefinition& study, const std::vector<std::string>&
   text += fmt::format("- written {:%Y-%m-%d %H:%M} UTC on a machine with {} hardware threads\n",
                       fmt::gmtime(std::time(nullptr)), std::thread::hardware_concurrency());
   const StandardViewOptions& d = study.setup.detector;
-  text += fmt::format("- registration preset `{}`; detector {}x{} px at {} mm, source-detector {} mm, source-isocentre "
-                      "{} mm; base seed {}\n",
-                      study.setup.preset, d.cols, d.rows, d.pixelSpacing_mm, d.sourceToDetector_mm,
-                      d.sourceToIsocentre_mm, study.setup.seed);
+  text += fmt::format("- registration preset `{}`; DRR method `{}`; detector {}x{} px at {} mm ({:g} x {:g} mm field), "
+                      "source-detector {} mm, source-isocentre {} mm; base seed {}\n",
+                      study.setup.preset, DrrRendererFactory::methodName(study.setup.method), d.cols, d.rows,
+                      d.pixelSpacing_mm, d.cols * d.pixelSpacing_mm, d.rows * d.pixelSpacing_mm,
+                      d.sourceToDetector_mm, d.sourceToIsocentre_mm, study.setup.seed);
   for (const std::string& note : notes) text += "- " + note + "\n";
   text += fmt::format("- success: final mean sTRE < {} mm; sTRE over the CT's bone-surface voxels (>= 250 HU), mTRE over "
                       "a 10x10x10 grid of the bone's bounding box\n\n",
@@ -66,23 +68,32 @@ std::string header(const StudyDefinition& study, const std::vector<std::string>&
   return text;
 }
 
+/// The slice spacing a condition registers on, as used (e.g. "3 mm (original)"), else as asked.
+std::string registrationSlices(const StudyCondition& c) {
+  if (c.usedSliceSpacing_mm <= 0.0) {
+    return c.sliceSpacing_mm > 0 ? fmt::format("{:g} mm", c.sliceSpacing_mm) : std::string("original");
+  }
+  const bool original = c.sliceSpacing_mm <= 0.0 || c.usedSliceSpacing_mm != c.sliceSpacing_mm;
+  return fmt::format("{:.3g} mm{}", c.usedSliceSpacing_mm, original ? " (original)" : "");
+}
+
 std::string statsColumns() {
   return "| trials | success | sTRE mean (mm) | sTRE max (mm) | sTRE mean, all (mm) | mTRE (mm) | rot (deg) | "
-         "trans (mm) | median time (s) | DRRs |";
+         "trans (mm) | median time (s) | setup s | DRRs |";
 }
 std::string statsCells(const ConditionStats& s) {
-  return fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0f} |", s.trials, percent(s), mm(s.streMean_mm),
-                     mm(s.streMax_mm), mm(s.streMeanAll_mm), mm(s.mtre_mm), mm(s.rotation_deg), mm(s.translation_mm),
-                     mm(s.medianSeconds), s.meanDrrs);
+  return fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0f} |", s.trials, percent(s),
+                     mm(s.streMean_mm), mm(s.streMax_mm), mm(s.streMeanAll_mm), mm(s.mtre_mm), mm(s.rotation_deg),
+                     mm(s.translation_mm), mm(s.medianSeconds), mm(s.meanSetupSeconds), s.meanDrrs);
 }
 
 std::string table2Section(const StudyDefinition& study, const std::vector<TrialRecord>& records) {
   std::string text = "## Results beside the paper\n\n| CT | scenario | registration slices " + statsColumns() +
-                     " paper mean sTRE (mm) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+                     " paper mean sTRE (mm) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const StudyCondition& c : study.conditions) {
     const ConditionStats s = StudyReport::statistics(recordsOf(study, c, records));
     text += fmt::format("| {} | {} | {} {} 0.3–0.4 * |\n", c.ct, c.scenario,
-                        c.sliceSpacing_mm > 0 ? fmt::format("{} mm", c.sliceSpacing_mm) : "original", statsCells(s));
+                        registrationSlices(c), statsCells(s));
   }
   text += "\n\\* The paper (Knaan & Joskowicz, MICCAI 2003) reports a mean sTRE of about 0.3–0.4 mm on its simulated "
           "data (figure as quoted in issue #5); its per-scenario Table 2 values (mean, max, success, time) are not "
@@ -119,7 +130,7 @@ std::string captureSection(const StudyDefinition& study, const std::vector<Trial
 }
 
 std::string conditionTable(const StudyDefinition& study, const std::vector<TrialRecord>& records, const char* what) {
-  std::string text = fmt::format("## Results\n\n| CT | {} {}\n|---|---|---|---|---|---|---|---|---|---|---|---|\n", what,
+  std::string text = fmt::format("## Results\n\n| CT | {} {}\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n", what,
                                  statsColumns());
   for (const StudyCondition& c : study.conditions) {
     const ConditionStats s = StudyReport::statistics(recordsOf(study, c, records));
@@ -226,7 +237,7 @@ std::vector<std::pair<std::string, ChartSpec>> charts(const StudyDefinition& stu
 ConditionStats StudyReport::statistics(const std::vector<TrialRecord>& records) {
   ConditionStats s;
   std::vector<double> seconds;
-  double sumMean = 0, sumMeanAll = 0, sumMaxAll = 0, sumMtre = 0, sumRot = 0, sumTrans = 0, sumDrrs = 0;
+  double sumMean = 0, sumMeanAll = 0, sumMaxAll = 0, sumMtre = 0, sumRot = 0, sumTrans = 0, sumDrrs = 0, sumSetup = 0;
   int registered = 0;
   s.streMax_mm = kNan;
   for (const TrialRecord& r : records) {
@@ -236,6 +247,7 @@ ConditionStats StudyReport::statistics(const std::vector<TrialRecord>& records) 
     ++registered;
     seconds.push_back(r.seconds);
     sumDrrs += static_cast<double>(r.drrs);
+    sumSetup += r.setupSeconds;
     sumMeanAll += r.error.streMean_mm;
     sumMaxAll += r.error.streMax_mm;
     if (!r.success) continue;
@@ -255,6 +267,7 @@ ConditionStats StudyReport::statistics(const std::vector<TrialRecord>& records) 
   s.streMeanAll_mm = mean(sumMeanAll, registered);
   s.streMaxAll_mm = mean(sumMaxAll, registered);
   s.meanDrrs = registered ? sumDrrs / registered : 0.0;
+  s.meanSetupSeconds = mean(sumSetup, registered);
   if (seconds.empty()) {
     s.medianSeconds = kNan;
   } else {

@@ -29,6 +29,7 @@ struct ConditionStats {
   double translation_mm = 0.0; ///< mean translation error, successful trials
   double medianSeconds = 0.0;  ///< median registration time, all registered trials
   double meanDrrs = 0.0;       ///< mean DRRs, all registered trials
+  double meanSetupSeconds = 0.0; ///< mean Transgraph table build/load time, all registered trials (NaN if none)
 };
 
 /// Writes study reports.

@@ -10,9 +10,11 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
+#include "DrrRendererFactory.h"
 #include "PoseErrorMetrics.h"
 #include "PoseOffset.h"
 #include "Registration.h"
@@ -43,8 +45,9 @@ struct PendingTrial {
   int trial = 0;
 };
 
-std::string caseKey(const StudyCondition& c) {
-  return fmt::format("{}|{}|{}", c.ct, c.sliceSpacing_mm, c.viewCount);
+/// Conditions registering on the same CT (after resampling, if any) with the same views share a case.
+std::string caseKey(const StudyCondition& c, const Volume& ct) {
+  return fmt::format("{}|{}|{}", c.ct, StudyXraySource::effectiveSliceSpacing_mm(ct, c.sliceSpacing_mm), c.viewCount);
 }
 
 Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, const StudyRunOptions& options) {
@@ -113,6 +116,8 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
     r.reason = result.error();
     return r;
   }
+  r.setupSeconds = result.value().viewRendererSetupSeconds;
+  r.seconds -= r.setupSeconds;
   r.status = "ok";
   r.drrs = result.value().totalDrrs;
   r.error = scene.metrics->measure(result.value().T_world_from_ct, scene.T_truth);
@@ -134,8 +139,27 @@ Eigen::Isometry3d StudyRunner::truthPose(const BoneSurface& bone) {
   return RigidPose::toTransform(truth, centre_ct_mm);
 }
 
+void StudyRunner::resolveSliceSpacings(StudyDefinition& study, const std::vector<StudyCt>& cts) {
+  for (StudyCondition& c : study.conditions) {
+    const auto ct = std::find_if(cts.begin(), cts.end(), [&](const StudyCt& s) { return s.label == c.ct; });
+    if (ct == cts.end()) continue;
+    const double resampled_mm = StudyXraySource::effectiveSliceSpacing_mm(ct->volume, c.sliceSpacing_mm);
+    c.usedSliceSpacing_mm = resampled_mm > 0.0 ? resampled_mm : ct->volume.spacing_mm().z();
+  }
+}
+
 std::vector<std::string> StudyRunner::notes(const StudyDefinition& study, const std::vector<StudyCt>& cts) {
   std::vector<std::string> out{"X-rays: " + StudyXraySource::description()};
+  if (study.setup.method == DrrMethod::Transgraph) {
+    out.push_back(fmt::format("DRRs: transgraph method, tables at a {:g} mm step built around each trial's start pose "
+                              "(not the truth) and cached in {}; the 'setup s' column is their build or load time, "
+                              "not part of the registration time",
+                              study.setup.transgraphSpacing_mm,
+                              study.setup.transgraphCacheDir.empty() ? std::string("no cache")
+                                                                     : study.setup.transgraphCacheDir.string()));
+  } else {
+    out.push_back(fmt::format("DRRs: {} method", DrrRendererFactory::methodName(study.setup.method)));
+  }
   std::set<std::string> said;
   for (const StudyCondition& c : study.conditions) {
     const auto ct = std::find_if(cts.begin(), cts.end(), [&](const StudyCt& s) { return s.label == c.ct; });
@@ -209,13 +233,21 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
     scenes.emplace(ct.label, std::move(scene));
   }
 
-  // Per (CT, slice spacing, view count): one prepared registration case, copied by each worker.
+  // Per (CT, slice spacing, view count): one prepared registration case, copied by each worker (transgraph method: by
+  // each trial, whose tables are then built around its own start pose by Registration::run).
+  RegistrationCaseOptions caseOptions;
+  caseOptions.drr.method = study.setup.method;
+  caseOptions.drr.transgraph.spacing_mm = study.setup.transgraphSpacing_mm;
+  caseOptions.drr.transgraphCacheFolder = study.setup.transgraphCacheDir.empty()
+                                              ? std::nullopt
+                                              : std::optional<std::filesystem::path>(study.setup.transgraphCacheDir);
+  const bool tablePerTrial = study.setup.method == DrrMethod::Transgraph;
   std::map<std::string, std::unique_ptr<RegistrationCase>> prototypes;
   for (const PendingTrial& p : pending) {
     const StudyCondition& c = *p.condition;
-    const std::string key = caseKey(c);
-    if (prototypes.count(key)) continue;
     const CtScene& scene = scenes.at(c.ct);
+    const std::string key = caseKey(c, *scene.ct);
+    if (prototypes.count(key)) continue;
     const double sliceSpacing_mm = StudyXraySource::effectiveSliceSpacing_mm(*scene.ct, c.sliceSpacing_mm);
     message(fmt::format("preparing registration on CT '{}' ({}) with {} views", c.ct,
                         sliceSpacing_mm > 0 ? fmt::format("{:g} mm slices", sliceSpacing_mm) : "original slices",
@@ -223,7 +255,7 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
     auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
     if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
     const std::vector<RegistrationView> views(scene.xrays.begin(), scene.xrays.begin() + c.viewCount);
-    auto created = RegistrationCase::create(registrationCt.value(), views);
+    auto created = RegistrationCase::create(registrationCt.value(), views, caseOptions);
     if (!created) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, created.error()));
     prototypes.emplace(key, std::make_unique<RegistrationCase>(std::move(created).value()));
   }
@@ -245,9 +277,13 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
       const std::size_t i = next.fetch_add(1);
       if (i >= pending.size() || storeFailed.load() || cancelled()) return;
       const StudyCondition& c = *pending[i].condition;
-      const std::string key = caseKey(c);
+      const std::string key = caseKey(c, *scenes.at(c.ct).ct);
       auto found = ownCases.find(key);
-      if (found == ownCases.end()) found = ownCases.emplace(key, *prototypes.at(key)).first;
+      if (found == ownCases.end()) {
+        found = ownCases.emplace(key, *prototypes.at(key)).first;
+      } else if (tablePerTrial) {
+        found->second = *prototypes.at(key);  // no tables yet: this trial builds (or loads) them around its start
+      }
       TrialRecord record;
       try {
         record = runTrial(study, c, pending[i].trial, scenes.at(c.ct), found->second, schedules.at(c.measures),

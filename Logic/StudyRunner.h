@@ -6,6 +6,9 @@
 // RegistrationCase on the registration CT. Trial t of a condition starts at a random pose whose mean sTRE from the
 // truth is drawn in the condition's initial range, both from seed = setup.seed + t (so conditions see the same start
 // directions), and registers with that seed. Trials run on `jobs` threads (each registration is itself threaded).
+// Transgraph method: each trial gets a fresh copy of the case, so its tables are built around that trial's START pose
+// (the truth is unknown at run time), or loaded from setup.transgraphCacheDir when another condition with the same
+// registration CT, views and start (same trial index) built them; the time goes to TrialRecord::setupSeconds.
 
 #include <Eigen/Geometry>
 
@@ -64,6 +67,9 @@ class StudyRunner {
   /// Notes for the report: the X-ray forward model, and each condition whose registration CT is the original although
   /// its scenario asks for coarser slices (the CT's own slices are already that coarse).
   static std::vector<std::string> notes(const StudyDefinition& study, const std::vector<StudyCt>& cts);
+  /// Sets every condition's usedSliceSpacing_mm: the slice spacing of the CT it registers on (its scenario's spacing,
+  /// or the CT's own when that is already as coarse). Conditions naming a CT not in `cts` are left at 0.
+  static void resolveSliceSpacings(StudyDefinition& study, const std::vector<StudyCt>& cts);
   /// The true pose T_world_from_ct used for a CT with this bone (see the file comment).
   static Eigen::Isometry3d truthPose(const BoneSurface& bone);
   /// `base` with every stage's metric set for `measures` (NCC only, VLNC only, or unchanged).

@@ -75,8 +75,8 @@ const std::vector<std::string>& TrialStore::columns() {
   static const std::vector<std::string> kColumns{
       "study",   "ct",          "condition", "scenario",     "variant",          "views",
       "trial",   "seed",        "initial_target_mm", "initial_stre_mm", "stre_mean_mm", "stre_max_mm",
-      "mtre_mm", "rotation_deg", "translation_mm", "success",   "seconds",          "drrs",
-      "status",  "reason"};
+      "mtre_mm", "rotation_deg", "translation_mm", "success",   "seconds",          "setup_seconds",
+      "drrs",    "status",      "reason"};
   return kColumns;
 }
 
@@ -85,11 +85,12 @@ std::string TrialStore::toCsv(const std::vector<TrialRecord>& records) {
   for (std::size_t c = 0; c < columns().size(); ++c) text += (c ? "," : "") + columns()[c];
   text += '\n';
   for (const TrialRecord& r : records) {
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", quoted(r.study), quoted(r.ct),
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", quoted(r.study), quoted(r.ct),
                         quoted(r.condition), quoted(r.scenario), quoted(r.variant), r.views, r.trial, r.seed,
                         number(r.initialTarget_mm), number(r.initialStre_mm), number(r.error.streMean_mm),
                         number(r.error.streMax_mm), number(r.error.mtre_mm), number(r.error.rotation_deg),
-                        number(r.error.translation_mm), r.success ? 1 : 0, number(r.seconds), r.drrs, quoted(r.status),
+                        number(r.error.translation_mm), r.success ? 1 : 0, number(r.seconds), number(r.setupSeconds), r.drrs,
+                        quoted(r.status),
                         quoted(r.reason));
   }
   return text;
@@ -132,14 +133,14 @@ Result<std::vector<TrialRecord>> TrialStore::fromCsv(const std::string& text, co
                     parseDouble(f[10], r.error.streMean_mm) && parseDouble(f[11], r.error.streMax_mm) &&
                     parseDouble(f[12], r.error.mtre_mm) && parseDouble(f[13], r.error.rotation_deg) &&
                     parseDouble(f[14], r.error.translation_mm) && parseInt(f[15], success) &&
-                    parseDouble(f[16], r.seconds) && parseInt(f[17], r.drrs);
+                    parseDouble(f[16], r.seconds) && parseDouble(f[17], r.setupSeconds) && parseInt(f[18], r.drrs);
     if (!ok) {
       return fail(fmt::format("{} line {}: a number field cannot be read; fix or delete the line to resume", where,
                               lineNumber));
     }
     r.success = success != 0;
-    r.status = f[18];
-    r.reason = f[19];
+    r.status = f[19];
+    r.reason = f[20];
     records.push_back(std::move(r));
   }
   return records;

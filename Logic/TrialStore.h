@@ -29,6 +29,7 @@ struct TrialRecord {
   PoseError error;                ///< of the final pose (NaN for a failed trial)
   bool success = false;           ///< PoseErrorMetrics::isSuccess(error)
   double seconds = 0.0;           ///< registration time
+  double setupSeconds = 0.0;      ///< Transgraph tables built or loaded for this trial before registering, seconds
   long drrs = 0;                  ///< DRRs rendered
   std::string status = "ok";      ///< "ok", "failed" (registration returned an error) or "cancelled"
   std::string reason;             ///< the error or cancellation message

@@ -15,4 +15,10 @@ int reportError(const std::string& message) {
   return kExitError;
 }
 
+bool parseDetectorSize(const std::string& text, int& cols, int& rows) {
+  char separator = 0, trailing = 0;
+  return std::sscanf(text.c_str(), "%d%c%d%c", &cols, &separator, &rows, &trailing) == 3 &&
+         (separator == 'x' || separator == 'X') && cols >= 1 && rows >= 1;
+}
+
 }  // namespace fct::cli

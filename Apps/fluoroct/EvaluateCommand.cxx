@@ -1,24 +1,31 @@
 // fluoroct evaluate: runs one of the paper's studies (StudyCatalog) with simulated X-rays of known truth, writes every
-// trial to DIR/trials.csv (resumable), then DIR/report.md and PNG charts (StudyReport).
+// trial to DIR/trials.csv (resumable), then DIR/report.md and PNG charts (StudyReport). The options that change results
+// (study, CTs, preset, detector, DRR method, ...) are kept in DIR/setup.txt; resuming with other options is refused.
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "CliSupport.h"
 #include "CtLoader.h"
+#include "DrrRendererFactory.h"
 #include "PhantomBuilder.h"
+#include "RegistrationSchedule.h"
 #include "StudyCatalog.h"
 #include "StudyReport.h"
 #include "StudyRunner.h"
+#include "TextFile.h"
 #include "TrialStore.h"
 
 namespace fct::cli {
@@ -34,7 +41,83 @@ struct EvaluateOptions {
   int jobs = 1;
   int trials = 0;  ///< > 0: at most this many trials per condition
   std::vector<std::string> cts;
+  std::string preset;    ///< empty: the study's (paper; quick: fast)
+  std::string detector;  ///< COLSxROWS; empty: the study's
+  double pixel_mm = 0.0; ///< > 0: detector pixel size
+  std::string method = "siddon";
 };
+
+/// The Transgraph table cache of a run: inside its output folder, so tables are shared by its trials only.
+fs::path transgraphCacheDir(const std::string& out) { return fs::path(out) / "transgraph-cache"; }
+
+/// The study's setup with the command's overrides applied; fails on an unknown preset, a bad detector or pixel size, or
+/// an unknown DRR method.
+Result<StudyDefinition> defineStudy(const EvaluateOptions& o, const std::vector<std::string>& ctLabels) {
+  auto method = DrrRendererFactory::parseMethod(o.method);
+  if (!method) return fail("--method: " + method.error());
+  if (method.value() != DrrMethod::Siddon && method.value() != DrrMethod::Transgraph) {
+    return fail(fmt::format("--method must be siddon or transgraph, got '{}'", o.method));
+  }
+  auto study = StudyCatalog::define(o.study, o.quick, ctLabels, method.value());
+  if (!study) return fail(study.error());
+  StudySetup& setup = study.value().setup;
+  if (!o.preset.empty()) setup.preset = o.preset;
+  if (auto schedule = RegistrationSchedule::resolve(setup.preset); !schedule) return fail("--preset: " + schedule.error());
+  if (!o.detector.empty() && !parseDetectorSize(o.detector, setup.detector.cols, setup.detector.rows)) {
+    return fail(fmt::format("--detector must be COLSxROWS with positive sizes, e.g. 384x288, got '{}'", o.detector));
+  }
+  if (o.pixel_mm < 0.0 || !std::isfinite(o.pixel_mm)) {
+    return fail(fmt::format("--pixel-mm must be a positive size in mm, got {}", o.pixel_mm));
+  }
+  if (o.pixel_mm > 0.0) setup.detector.pixelSpacing_mm = o.pixel_mm;
+  if (method.value() == DrrMethod::Transgraph) setup.transgraphCacheDir = transgraphCacheDir(o.out);
+  return study;
+}
+
+/// The options of a run that change its results, one "key: value" line each (DIR/setup.txt; compared on resume).
+std::string setupText(const EvaluateOptions& o, const StudySetup& setup) {
+  const StandardViewOptions& d = setup.detector;
+  std::string preset = setup.preset;
+  if (fs::is_regular_file(preset)) {  // a preset file: its text matters, not only its name
+    auto text = TextFile::read(preset);
+    if (text) {
+      std::uint64_t hash = 14695981039346656037ull;  // FNV-1a of the file's text
+      for (unsigned char c : text.value()) hash = (hash ^ c) * 1099511628211ull;
+      preset += fmt::format(" (file, {} bytes, FNV-1a {:016x})", text.value().size(), hash);
+    }
+  }
+  return fmt::format("study: {}\nquick: {}\ncts: {}\npreset: {}\ndetector: {}x{}\npixel_mm: {:g}\nsid_mm: {:g}\n"
+                     "sad_mm: {:g}\nmethod: {}\ntransgraph_spacing_mm: {:g}\nseed: {}\n",
+                     o.study, o.quick ? "yes" : "no", o.cts.empty() ? "default" : fmt::format("{}", fmt::join(o.cts, " ")),
+                     preset, d.cols, d.rows, d.pixelSpacing_mm, d.sourceToDetector_mm, d.sourceToIsocentre_mm,
+                     DrrRendererFactory::methodName(setup.method), setup.transgraphSpacing_mm, setup.seed);
+}
+
+/// Resume check: a folder that already holds trials must have been run with the same setup. Writes DIR/setup.txt.
+Status checkAndStoreSetup(const fs::path& out, const std::string& setup, bool hasTrials) {
+  const fs::path file = out / "setup.txt";
+  if (hasTrials) {
+    auto stored = TextFile::read(file);
+    if (!stored) {
+      return fail(fmt::format("{} holds trials but no setup.txt (made by an older fluoroct?), so the options it was run "
+                              "with are unknown; use another --out",
+                              out.string()));
+    }
+    if (stored.value() != setup) {
+      std::string differences;
+      std::istringstream was(stored.value()), now(setup);
+      for (std::string a, b; std::getline(now, b);) {
+        if (!std::getline(was, a)) a = "(none)";
+        if (a != b) differences += fmt::format("{}'{}' now, '{}' stored", differences.empty() ? "" : "; ", b, a);
+      }
+      return fail(fmt::format("{} holds trials run with other options ({}); resume with the same options as in {}, or "
+                              "use another --out",
+                              out.string(), differences, file.string()));
+    }
+    return Ok{};
+  }
+  return TextFile::writeAtomically(file, setup);
+}
 
 std::atomic<bool> g_cancel{false};
 extern "C" void onEvaluateInterrupt(int) { g_cancel.store(true); }
@@ -102,6 +185,14 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, bool& skip) {
   return cts;
 }
 
+/// `text` with its line breaks turned into "; ".
+std::string oneLine(const std::string& text) {
+  std::string out;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) out += (out.empty() ? "" : "; ") + line;
+  return out;
+}
+
 /// Creates `out` and checks that a file can be written in it.
 Status prepareOutput(const fs::path& out) {
   std::error_code ec;
@@ -118,13 +209,18 @@ Status prepareOutput(const fs::path& out) {
 }
 
 int runEvaluate(const EvaluateOptions& o) {
-  // The study name is checked before anything is loaded (the CT labels are placeholders here).
-  if (auto known = StudyCatalog::define(o.study, o.quick, {"ct"}); !known) return reportError(known.error());
+  // The study and options are checked before anything is loaded (the CT labels are placeholders here).
+  auto known = defineStudy(o, {"ct"});
+  if (!known) return reportError(known.error());
   if (o.jobs < 1) return reportError(fmt::format("--jobs must be at least 1, got {}", o.jobs));
   if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
   if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
   auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
   if (!store) return reportError(store.error());
+  const std::string setup = setupText(o, known.value().setup);
+  if (Status same = checkAndStoreSetup(o.out, setup, !store.value().records().empty()); !same) {
+    return reportError(same.error());
+  }
 
   bool skip = false;
   auto cts = loadCts(o, skip);
@@ -132,15 +228,20 @@ int runEvaluate(const EvaluateOptions& o) {
   if (skip) return 0;
   std::vector<std::string> labels;
   for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
-  auto study = StudyCatalog::define(o.study, o.quick, labels);
+  auto study = defineStudy(o, labels);
   if (!study) return reportError(study.error());
+  StudyRunner::resolveSliceSpacings(study.value(), cts.value());
   std::size_t total = 0;
   for (StudyCondition& c : study.value().conditions) {
     if (o.trials > 0) c.trials = std::min(c.trials, o.trials);
     total += static_cast<std::size_t>(c.trials);
   }
-  fmt::print(stderr, "evaluate: study '{}'{} on {}: {} conditions, {} trials, {} job(s)\n", o.study,
-             o.quick ? " (quick)" : "", fmt::join(labels, ", "), study.value().conditions.size(), total, o.jobs);
+  const StudySetup& s = study.value().setup;
+  fmt::print(stderr, "evaluate: study '{}'{} on {}: {} conditions, {} trials, {} job(s); preset {}, detector {}x{} at {:g} "
+                     "mm, {} DRRs\n",
+             o.study, o.quick ? " (quick)" : "", fmt::join(labels, ", "), study.value().conditions.size(), total, o.jobs,
+             s.preset, s.detector.cols, s.detector.rows, s.detector.pixelSpacing_mm,
+             DrrRendererFactory::methodName(s.method));
 
   StudyRunOptions run;
   run.jobs = o.jobs;
@@ -148,10 +249,11 @@ int runEvaluate(const EvaluateOptions& o) {
   run.onMessage = [](const std::string& text) { fmt::print(stderr, "evaluate: {}\n", text); };
   run.onTrial = [](const StudyProgress& p) {
     const TrialRecord& r = p.record;
-    fmt::print(stderr, "[{}/{}] {} trial {}: initial sTRE {:.2f} mm -> {:.3f} mm (max {:.3f}) {}{} {:.1f} s, {} DRRs\n",
+    fmt::print(stderr, "[{}/{}] {} trial {}: initial sTRE {:.2f} mm -> {:.3f} mm (max {:.3f}) {}{} {:.1f} s{}, {} DRRs\n",
                p.finished, p.toRun, r.condition, r.trial, r.initialStre_mm, r.error.streMean_mm, r.error.streMax_mm,
                r.status == "ok" ? (r.success ? "success" : "FAILURE") : r.status,
-               r.reason.empty() ? "" : " (" + r.reason + ")", r.seconds, r.drrs);
+               r.reason.empty() ? "" : " (" + r.reason + ")", r.seconds,
+               r.setupSeconds > 0 ? fmt::format(" (+{:.1f} s tables)", r.setupSeconds) : "", r.drrs);
   };
   g_cancel = false;
   const auto previousHandler = std::signal(SIGINT, onEvaluateInterrupt);
@@ -160,10 +262,15 @@ int runEvaluate(const EvaluateOptions& o) {
   if (!summary) return reportError(summary.error());
 
   std::vector<std::string> notes = StudyRunner::notes(study.value(), cts.value());
-  notes.insert(notes.begin(), fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}`", o.study,
-                                          o.quick ? " --quick" : "", o.out,
-                                          o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
-                                          o.cts.empty() ? "" : fmt::format(" --ct {}", fmt::join(o.cts, " "))));
+  notes.insert(notes.begin(),
+               fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}{}{}{} --method {}`; setup (compared on "
+                           "resume, DIR/setup.txt): {}",
+                           o.study, o.quick ? " --quick" : "", o.out,
+                           o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
+                           o.cts.empty() ? "" : fmt::format(" --ct {}", fmt::join(o.cts, " ")),
+                           o.preset.empty() ? "" : " --preset " + o.preset,
+                           o.detector.empty() ? "" : " --detector " + o.detector,
+                           o.pixel_mm > 0 ? fmt::format(" --pixel-mm {:g}", o.pixel_mm) : "", o.method, oneLine(setup)));
   auto written = StudyReport::write(study.value(), store.value().records(), notes, o.out);
   if (!written) return reportError(written.error());
   std::vector<std::string> names;
@@ -193,6 +300,16 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--ct", options->cts,
                       "CT volume(s) or DICOM folder(s) instead of the defaults (full: ../shared/data pelvis, plus the "
                       "head phantom for table2; quick: the phantom)");
+  command->add_option("--preset", options->preset,
+                      "Registration preset: paper, fast or a preset FILE.json (default: paper; --quick: fast)");
+  command->add_option("--detector", options->detector,
+                      "Detector size in pixels, COLSxROWS (default 800x600; --quick 128x128); the field is COLS x "
+                      "--pixel-mm wide, as in `fluoroct views`");
+  command->add_option("--pixel-mm", options->pixel_mm, "Detector pixel size in mm (default 0.4; --quick 2.4)");
+  command->add_option("--method", options->method,
+                      "DRR method: siddon (exact) or transgraph (tables built around each trial's start pose, cached "
+                      "in OUT/transgraph-cache)")
+      ->capture_default_str();
   command->callback([&action, options] { action = [options] { return runEvaluate(*options); }; });
 }
 

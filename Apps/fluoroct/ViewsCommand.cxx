@@ -40,9 +40,7 @@ void registerViewsCommand(CLI::App& app, CommandAction& action) {
   command->callback([&action, options] {
     action = [options] {
       int cols = 0, rows = 0;
-      char separator = 0, trailing = 0;
-      if (std::sscanf(options->detector.c_str(), "%d%c%d%c", &cols, &separator, &rows, &trailing) != 3 ||
-          (separator != 'x' && separator != 'X')) {
+      if (!parseDetectorSize(options->detector, cols, rows)) {
         return reportError(fmt::format("--detector must be COLSxROWS, e.g. 800x600, got '{}'", options->detector));
       }
       options->views.cols = cols;

@@ -1,5 +1,5 @@
 // fluoroct evaluate: the four quick studies end to end on the built-in phantom (CSV rows, valid PNG charts, report
-// tables), resume, and bad input. The quick studies are what CI runs; each takes 15-60 s on 2 cores.
+// tables), resume (and its refusal when the options differ), and bad input. The quick studies are what CI runs.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
@@ -41,11 +41,12 @@ std::pair<std::uint32_t, std::uint32_t> pngSize(const fs::path& path) {
 }
 
 /// Runs a quick study into `out` and checks the CSV has one row per trial and every chart is a valid 900x560 PNG.
-void runQuickStudy(const std::string& study, const fs::path& out, const std::string& extra = "") {
+void runQuickStudy(const std::string& study, const fs::path& out, const std::string& extra = "",
+                   fct::DrrMethod method = fct::DrrMethod::Siddon) {
   const auto run = fct::test::runCli(fmt::format("evaluate --study {} --quick --out '{}' {}", study, out.string(), extra));
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.err.find("[1/"), std::string::npos) << "progress on stderr: " << run.err;
-  const auto definition = fct::StudyCatalog::define(study, true, {"phantom"}).value();
+  const auto definition = fct::StudyCatalog::define(study, true, {"phantom"}, method).value();
   int trials = 0;
   for (const fct::StudyCondition& c : definition.conditions) trials += c.trials;
   const auto store = fct::TrialStore::open(out / "trials.csv");
@@ -65,6 +66,11 @@ void runQuickStudy(const std::string& study, const fs::path& out, const std::str
   EXPECT_NE(readText(out / "report.md").find(fmt::format("# Study `{}` (quick)", study)), std::string::npos);
 }
 
+/// The setup.txt of `evaluate --study table2 --quick` (every default spelled out).
+const std::string kQuickTable2Setup =
+    "study: table2\nquick: yes\ncts: default\npreset: fast\ndetector: 128x128\npixel_mm: 2.4\nsid_mm: 1000\n"
+    "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\n";
+
 }  // namespace
 
 TEST(EvaluateCommand, QuickTable2WritesTrialsChartsAndTheTableBesideThePaper) {
@@ -72,21 +78,33 @@ TEST(EvaluateCommand, QuickTable2WritesTrialsChartsAndTheTableBesideThePaper) {
   runQuickStudy("table2", out);
   const std::string csv = readText(out / "trials.csv");
   EXPECT_EQ(csv.rfind("study,ct,condition,scenario,variant,views,trial,seed,initial_target_mm,initial_stre_mm,"
-                      "stre_mean_mm,stre_max_mm,mtre_mm,rotation_deg,translation_mm,success,seconds,drrs,status,reason\n",
+                      "stre_mean_mm,stre_max_mm,mtre_mm,rotation_deg,translation_mm,success,seconds,setup_seconds,drrs,status,"
+                      "reason\n",
                       0),
             0u);
   const std::string report = readText(out / "report.md");
   EXPECT_NE(report.find("| phantom | realistic | 2.4 mm | 2 |"), std::string::npos) << report;
+  EXPECT_NE(report.find("| phantom | ideal | 2 mm (original) | 2 |"), std::string::npos) << report;
+  EXPECT_NE(report.find("DRR method `siddon`; detector 128x128 px at 2.4 mm"), std::string::npos) << report;
+  EXPECT_NE(readText(out / "setup.txt").find("detector: 128x128\npixel_mm: 2.4\n"), std::string::npos);
   EXPECT_NE(report.find("paper mean sTRE"), std::string::npos);
   EXPECT_NE(report.find("![Success rate by scenario](table2_success.png)"), std::string::npos);
 }
 
 TEST(EvaluateCommand, QuickCaptureStudyRuns) { runQuickStudy("capture", fct::test::scratchDir() / "capture"); }
 
-TEST(EvaluateCommand, QuickAblationStudyRunsAndReportsTheTransgraphGap) {
+TEST(EvaluateCommand, QuickAblationWithTransgraphHasANoTransgraphRow) {
   const auto out = fct::test::scratchDir() / "ablation";
-  runQuickStudy("ablation", out);
-  EXPECT_NE(readText(out / "report.md").find("Transgraph off: not measured"), std::string::npos);
+  runQuickStudy("ablation", out, "--method transgraph", fct::DrrMethod::Transgraph);
+  const std::string report = readText(out / "report.md");
+  EXPECT_NE(report.find("| phantom | no-transgraph | 2 |"), std::string::npos) << report;
+  EXPECT_EQ(report.find("Transgraph off: no row"), std::string::npos) << report;
+  EXPECT_NE(report.find("DRR method `transgraph`"), std::string::npos) << report;
+  const auto store = fct::TrialStore::open(out / "trials.csv").value();
+  for (const fct::TrialRecord& r : store.records()) {
+    if (r.variant == "no-transgraph") EXPECT_EQ(r.setupSeconds, 0.0) << "no tables for the Siddon row";
+  }
+  EXPECT_TRUE(fs::is_directory(out / "transgraph-cache"));
 }
 
 TEST(EvaluateCommand, QuickViewsStudyRunsOnTwoJobs) {
@@ -113,6 +131,7 @@ TEST(EvaluateCommand, ResumeRunsOnlyTheTrialsNotYetInTheCsv) {
     }
   }
   ASSERT_TRUE(fct::TextFile::writeAtomically(out / "trials.csv", fct::TrialStore::toCsv(done)).ok());
+  ASSERT_TRUE(fct::TextFile::writeAtomically(out / "setup.txt", kQuickTable2Setup).ok());
   const auto run = fct::test::runCli(fmt::format("evaluate --study table2 --quick --out '{}'", out.string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("ran 1 trials (0 failed), skipped 5"), std::string::npos) << run.out;
@@ -125,6 +144,60 @@ TEST(EvaluateCommand, ResumeRunsOnlyTheTrialsNotYetInTheCsv) {
   const auto again = fct::test::runCli(fmt::format("evaluate --study table2 --quick --out '{}'", out.string()));
   ASSERT_EQ(again.exitCode, 0) << again.err;
   EXPECT_NE(again.out.find("ran 0 trials (0 failed), skipped 6"), std::string::npos) << again.out;
+}
+
+TEST(EvaluateCommand, ResumeWithOtherOptionsIsRefused) {
+  const auto out = fct::test::scratchDir();
+  fct::TrialRecord r;
+  r.study = "table2";
+  r.ct = "phantom";
+  r.condition = "phantom/ideal";
+  r.views = 3;
+  r.error = fct::PoseError{0.1, 0.2, 0.1, 0.1, 0.1};
+  const std::string csv = fct::TrialStore::toCsv({r});
+  ASSERT_TRUE(fct::TextFile::writeAtomically(out / "trials.csv", csv).ok());
+  const auto noSetup = fct::test::runCli(fmt::format("evaluate --study table2 --quick --out '{}'", out.string()));
+  EXPECT_EQ(noSetup.exitCode, 2);
+  EXPECT_NE(noSetup.err.find("holds trials but no setup.txt"), std::string::npos) << noSetup.err;
+
+  ASSERT_TRUE(fct::TextFile::writeAtomically(out / "setup.txt", kQuickTable2Setup).ok());
+  const auto other = fct::test::runCli(
+      fmt::format("evaluate --study table2 --quick --detector 96x96 --pixel-mm 3.2 --out '{}'", out.string()));
+  EXPECT_EQ(other.exitCode, 2);
+  EXPECT_EQ(other.err.rfind("error: ", 0), 0u);
+  EXPECT_NE(other.err.find("holds trials run with other options ('detector: 96x96' now, 'detector: 128x128' stored; "
+                           "'pixel_mm: 3.2' now, 'pixel_mm: 2.4' stored)"),
+            std::string::npos)
+      << other.err;
+  const auto method = fct::test::runCli(
+      fmt::format("evaluate --study table2 --quick --method transgraph --out '{}'", out.string()));
+  EXPECT_EQ(method.exitCode, 2);
+  EXPECT_NE(method.err.find("'method: transgraph' now, 'method: siddon' stored"), std::string::npos) << method.err;
+  EXPECT_EQ(readText(out / "trials.csv"), csv);  // nothing ran, nothing rewritten
+  EXPECT_EQ(readText(out / "setup.txt"), kQuickTable2Setup);
+}
+
+TEST(EvaluateCommand, BadOptionsAreRefusedBeforeAnythingIsWritten) {
+  const auto dir = fct::test::scratchDir();
+  const auto run = [&](const std::string& options) {
+    return fct::test::runCli(fmt::format("evaluate --study views --quick {} --out '{}'", options, (dir / "o").string()));
+  };
+  const auto detector = run("--detector 128by96");
+  EXPECT_EQ(detector.exitCode, 2);
+  EXPECT_EQ(detector.err.rfind("error: --detector must be COLSxROWS", 0), 0u) << detector.err;
+  const auto zero = run("--detector 0x96");
+  EXPECT_EQ(zero.exitCode, 2);
+  EXPECT_NE(zero.err.find("--detector"), std::string::npos) << zero.err;
+  const auto preset = run("--preset no-such-preset");
+  EXPECT_EQ(preset.exitCode, 2);
+  EXPECT_EQ(preset.err.rfind("error: --preset: ", 0), 0u) << preset.err;
+  const auto pixel = run("--pixel-mm=-1");
+  EXPECT_EQ(pixel.exitCode, 2);
+  EXPECT_NE(pixel.err.find("--pixel-mm"), std::string::npos) << pixel.err;
+  const auto method = run("--method raycast");
+  EXPECT_EQ(method.exitCode, 2);
+  EXPECT_NE(method.err.find("--method must be siddon or transgraph"), std::string::npos) << method.err;
+  EXPECT_FALSE(fs::exists(dir / "o"));
 }
 
 TEST(EvaluateCommand, BadInputGivesOneErrorLine) {

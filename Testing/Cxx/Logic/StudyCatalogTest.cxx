@@ -41,11 +41,22 @@ TEST(StudyCatalog, CaptureBinsCoverZeroToSixtyMillimetres) {
   EXPECT_DOUBLE_EQ(study.conditions[5].initialHigh_mm, 60.0);
 }
 
-TEST(StudyCatalog, AblationReportsTheTransgraphGapInsteadOfARow) {
+TEST(StudyCatalog, AblationWithSiddonReportsTheTransgraphGapInsteadOfARow) {
   const auto study = fct::StudyCatalog::define("ablation", true, {"phantom"}).value();
   for (const fct::StudyCondition& c : study.conditions) EXPECT_EQ(c.variant.find("transgraph"), std::string::npos);
   ASSERT_EQ(study.gaps.size(), 1u);
-  EXPECT_NE(study.gaps[0].find("Transgraph"), std::string::npos);
+  EXPECT_NE(study.gaps[0].find("--method transgraph"), std::string::npos) << study.gaps[0];
+}
+
+TEST(StudyCatalog, AblationWithTransgraphHasANoTransgraphRowAndNoGap) {
+  const auto study = fct::StudyCatalog::define("ablation", true, {"phantom"}, fct::DrrMethod::Transgraph).value();
+  EXPECT_EQ(study.setup.method, fct::DrrMethod::Transgraph);
+  EXPECT_TRUE(study.gaps.empty());
+  ASSERT_EQ(study.conditions.size(), 7u);
+  EXPECT_EQ(study.conditions[0].variant, "full");
+  EXPECT_FALSE(study.conditions[0].ablation.noTransgraph);
+  EXPECT_EQ(study.conditions[1].variant, "no-transgraph");
+  EXPECT_TRUE(study.conditions[1].ablation.noTransgraph);
 }
 
 TEST(StudyCatalog, UnknownStudyOrNoCtIsRejected) {

@@ -70,7 +70,18 @@ TEST(StudyXraySource, RegistrationCtIsTheOriginalUnlessTheScenarioAsksForCoarser
 TEST(StudyRunner, NotesSayWhenAScenarioKeepsTheOriginalCt) {
   const auto study = fct::StudyCatalog::define("table2", false, {"pelvis"}).value();
   const std::vector<std::string> notes = fct::StudyRunner::notes(study, {{"pelvis", tinyCt(3.0)}});
-  ASSERT_EQ(notes.size(), 2u);  // the X-ray model, then 'realistic' (2.4 mm < 3 mm); 'bad' (4.2 mm) is resampled
+  ASSERT_EQ(notes.size(), 3u);  // X-ray model, DRR method, 'realistic' (2.4 mm < 3 mm); 'bad' (4.2 mm) is resampled
   EXPECT_EQ(notes[0].rfind("X-rays: FluoroscopySimulator", 0), 0u);
-  EXPECT_NE(notes[1].find("scenario 'realistic'"), std::string::npos) << notes[1];
+  EXPECT_EQ(notes[1], "DRRs: siddon method");
+  EXPECT_NE(notes[2].find("scenario 'realistic'"), std::string::npos) << notes[2];
+}
+
+TEST(StudyRunner, ResolveSliceSpacingsGivesTheSpacingActuallyUsed) {
+  auto study = fct::StudyCatalog::define("table2", false, {"pelvis", "missing"}).value();
+  fct::StudyRunner::resolveSliceSpacings(study, {{"pelvis", tinyCt(3.0)}});
+  ASSERT_EQ(study.conditions.size(), 6u);  // pelvis ideal, realistic, bad; missing ideal, realistic, bad
+  EXPECT_DOUBLE_EQ(study.conditions[0].usedSliceSpacing_mm, 3.0);  // ideal: the original
+  EXPECT_DOUBLE_EQ(study.conditions[1].usedSliceSpacing_mm, 3.0);  // realistic asks 2.4 mm: the original is coarser
+  EXPECT_DOUBLE_EQ(study.conditions[2].usedSliceSpacing_mm, 4.2);  // bad: resampled
+  EXPECT_EQ(study.conditions[3].usedSliceSpacing_mm, 0.0);         // no such CT: left unresolved
 }
