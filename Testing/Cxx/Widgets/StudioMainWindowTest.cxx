@@ -82,12 +82,13 @@ TEST_F(StudioMainWindowTest, ShowsTitleMenusDataStepAndReadyStatus) {
 
 TEST_F(StudioMainWindowTest, StepsAddedByOneLineGetTheViewsAndActivation) {
   StudioMainWindow window(m_folder / "autosave.json");
-  auto* step = window.addStep(QStringLiteral("Initial pose"), new CountingStep);
-  EXPECT_EQ(window.stepCount(), 2);
+  const int builtinSteps = window.stepCount();
+  auto* step = window.addStep(QStringLiteral("Counting step"), new CountingStep);
+  EXPECT_EQ(window.stepCount(), builtinSteps + 1);
   EXPECT_EQ(step->attachments, 1);
   EXPECT_TRUE(step->slicesAttached);
-  EXPECT_TRUE(window.showStepNamed(QStringLiteral("initial-pose")));
-  EXPECT_EQ(window.currentStep(), 1);
+  EXPECT_TRUE(window.showStepNamed(QStringLiteral("counting-step")));
+  EXPECT_EQ(window.currentStep(), builtinSteps);
   EXPECT_EQ(step->activations, 1);
   window.showStep(0);
   EXPECT_EQ(step->deactivations, 1);
