@@ -1,5 +1,5 @@
 // fluoroct-studio: the FluoroCT desktop program (thin entry point).
-// fluoroct-studio [SESSION | --case DIR] [--step NAME] [--screenshot FILE]
+// fluoroct-studio [SESSION | --case DIR] [--step NAME] [--register] [--screenshot FILE]
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QDir>
@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "DataStepWidget.h"
+#include "RegisterStepWidget.h"
 #include "StudioMainWindow.h"
 
 namespace {
@@ -47,8 +48,13 @@ int main(int argc, char** argv) {
       QStringLiteral("screenshot"),
       QStringLiteral("Save a PNG of the window to <file> once it is shown (and the case loaded), then quit."),
       QStringLiteral("file"));
+  const QCommandLineOption runRegistration(
+      QStringLiteral("register"),
+      QStringLiteral("Once the case is loaded, run a registration as the Register step's Run button does (with "
+                     "--screenshot: the picture is taken when it has finished)."));
   parser.addOption(caseFolder);
   parser.addOption(step);
+  parser.addOption(runRegistration);
   parser.addOption(screenshot);
   parser.process(app);
   const QStringList positional = parser.positionalArguments();
@@ -83,24 +89,35 @@ int main(int argc, char** argv) {
     window.dataStep()->openCaseFolder(parser.value(caseFolder));
   }
 
-  if (parser.isSet(screenshot)) {
+  const auto take = [&window, &parser, &screenshot] {
+    if (!parser.isSet(screenshot)) return;
     const QString path = parser.value(screenshot);
-    const auto take = [&window, path] {
-      QTimer::singleShot(700, &window, [&window, path] {
-        if (!window.grab().save(path, "PNG")) {
-          std::fprintf(stderr, "error: could not write the screenshot to '%s'; check the folder exists and is writable\n",
-                       path.toLocal8Bit().constData());
-          QApplication::exit(2);
-          return;
-        }
-        QApplication::exit(0);  // not quit(): that would close the window and ask about the unsaved case
-      });
-    };
-    if (loading && window.dataStep()->isBusy()) {
-      QObject::connect(window.dataStep(), &fct::DataStepWidget::loadFinished, &window, take);
-    } else {
+    QTimer::singleShot(700, &window, [&window, path] {
+      if (!window.grab().save(path, "PNG")) {
+        std::fprintf(stderr, "error: could not write the screenshot to '%s'; check the folder exists and is writable\n",
+                     path.toLocal8Bit().constData());
+        QApplication::exit(2);
+        return;
+      }
+      QApplication::exit(0);  // not quit(): that would close the window and ask about the unsaved case
+    });
+  };
+  // After loading: optionally register (the Register step reports any error in its own log), then the screenshot.
+  const auto afterLoad = [&window, &parser, &runRegistration, take] {
+    auto* registerStep = window.findChild<fct::RegisterStepWidget*>();
+    if (!parser.isSet(runRegistration) || registerStep == nullptr) {
       take();
+      return;
     }
+    QObject::connect(registerStep, &fct::RegisterStepWidget::runningChanged, &window, [take](bool running) {
+      if (!running) take();
+    });
+    if (!registerStep->run()) take();
+  };
+  if (loading && window.dataStep()->isBusy()) {
+    QObject::connect(window.dataStep(), &fct::DataStepWidget::loadFinished, &window, afterLoad);
+  } else {
+    afterLoad();
   }
   return QApplication::exec();
 }
