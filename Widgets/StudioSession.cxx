@@ -6,6 +6,7 @@
 
 #include "JsonDocument.h"
 #include "JsonReader.h"
+#include "RegistrationStagesJson.h"
 #include "RigidPose.h"
 
 namespace fct {
@@ -49,20 +50,6 @@ std::string verdictName(ResultVerdict verdict) {
 ordered_json pose(const Eigen::Isometry3d& T) { return JsonDocument::array(T.matrix()); }
 
 ordered_json resultJson(const RegistrationResult& r, ResultVerdict verdict) {
-  ordered_json stages = ordered_json::array();
-  for (const StageReport& s : r.stages) {
-    stages.push_back({{"name", s.name},
-                      {"metric", s.metric},
-                      {"level", s.level},
-                      {"search", s.search},
-                      {"seconds", s.seconds},
-                      {"drrs", s.drrs},
-                      {"evaluations", s.evaluations},
-                      {"start_similarity", s.startSimilarity},
-                      {"similarity", s.similarity},
-                      {"kept_fraction", s.keptFraction},
-                      {"cancelled", s.cancelled}});
-  }
   return ordered_json{{"T_world_from_ct", pose(r.T_world_from_ct)},
                       {"T_initial", pose(r.T_initial)},
                       {"rotation_centre_ct_mm", JsonDocument::array(r.rotationCentre_ct_mm)},
@@ -72,7 +59,7 @@ ordered_json resultJson(const RegistrationResult& r, ResultVerdict verdict) {
                       {"total_drrs", r.totalDrrs},
                       {"drr_method", r.drrMethod},
                       {"view_names", r.viewNames},
-                      {"stages", std::move(stages)},
+                      {"stages", RegistrationStagesJson::write(r)},
                       {"schedule", r.schedule.toJson()}};
 }
 
@@ -202,9 +189,12 @@ Result<RegistrationResult> readResult(const nlohmann::json& json, const std::str
       stage.evaluations = s.integer("evaluations", 0);
       stage.startSimilarity = s.number("start_similarity");
       stage.similarity = s.number("similarity");
-      if (const nlohmann::json* kept = s.find("kept_fraction"); kept && kept->is_array()) {
-        for (const auto& value : *kept) {
-          if (value.is_number()) stage.keptFraction.push_back(value.get<double>());
+      stage.fallbackRays = static_cast<long>(s.integer("fallback_rays", 0));
+      if (const nlohmann::json* kept = s.find("kept_fraction"); kept && kept->is_object()) {
+        for (const std::string& view : r.viewNames) {
+          const auto value = kept->find(view);
+          if (value == kept->end() || !value->is_number()) break;
+          stage.keptFraction.push_back(value->get<double>());
         }
       }
       stage.cancelled = boolean(s, "cancelled");

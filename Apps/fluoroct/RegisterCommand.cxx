@@ -23,6 +23,7 @@
 #include "LandmarkPoseEstimator.h"
 #include "PoseFile.h"
 #include "Registration.h"
+#include "RegistrationStagesJson.h"
 #include "ViewFile.h"
 #include "XrayLoader.h"
 
@@ -135,29 +136,12 @@ Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const O
 
 nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o, nlohmann::ordered_json initial,
                                   nlohmann::ordered_json transgraph) {
-  nlohmann::ordered_json stages = nlohmann::ordered_json::array();
-  for (const StageReport& s : r.stages) {
-    nlohmann::ordered_json kept = nlohmann::ordered_json::object();
-    for (std::size_t v = 0; v < s.keptFraction.size() && v < r.viewNames.size(); ++v) kept[r.viewNames[v]] = s.keptFraction[v];
-    stages.push_back({{"name", s.name},
-                      {"metric", s.metric},
-                      {"level", s.level},
-                      {"search", s.search},
-                      {"seconds", s.seconds},
-                      {"drrs", s.drrs},
-                      {"fallback_rays", s.fallbackRays},
-                      {"evaluations", s.evaluations},
-                      {"start_similarity", s.startSimilarity},
-                      {"similarity", s.similarity},
-                      {"kept_fraction", kept},
-                      {"cancelled", s.cancelled}});
-  }
   initial["T_world_from_ct"] = JsonDocument::array(r.T_initial.matrix());
   return nlohmann::ordered_json{
       {"T_world_from_ct", JsonDocument::array(r.T_world_from_ct.matrix())},
       {"cancelled", r.cancelled},
       {"initial_pose", std::move(initial)},
-      {"stages", std::move(stages)},
+      {"stages", RegistrationStagesJson::write(r)},
       {"total_seconds", r.totalSeconds},
       {"total_drrs", r.totalDrrs},
       {"transgraph", std::move(transgraph)},
