@@ -39,7 +39,9 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   m_seedSpin->setRange(0, 1000000);
   form->addRow(tr("Random seed"), m_seedSpin);
   m_methodCombo = new QComboBox(optionsBox);
-  m_methodCombo->addItems({QStringLiteral("siddon"), QStringLiteral("raycast")});
+  m_methodCombo->addItems({QStringLiteral("siddon"), QStringLiteral("raycast"), QStringLiteral("transgraph")});
+  m_methodCombo->setToolTip(tr("transgraph: precomputed ray tables, one per view, built around the initial pose at the "
+                               "first run (takes a while once; later runs of the same case reuse them)"));
   form->addRow(tr("DRR method"), m_methodCombo);
   layout->addWidget(optionsBox);
 
@@ -50,7 +52,9 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   m_nccOnlyCheck = new QCheckBox(tr("VLNC (NCC in every stage)"), ablationBox);
   m_localOnlyCheck = new QCheckBox(tr("Global search (local simplex only)"), ablationBox);
   m_cmaesCheck = new QCheckBox(tr("Genetic search (CMA-ES instead)"), ablationBox);
-  for (QCheckBox* check : {m_noRoisCheck, m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck, m_cmaesCheck}) {
+  m_noTransgraphCheck = new QCheckBox(tr("Transgraph (exact DRRs instead of the tables)"), ablationBox);
+  for (QCheckBox* check :
+       {m_noRoisCheck, m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck, m_cmaesCheck, m_noTransgraphCheck}) {
     ablationLayout->addWidget(check);
   }
   layout->addWidget(ablationBox);
@@ -121,6 +125,7 @@ RegistrationAblation RegisterStepWidget::ablation() const {
   ablation.nccOnly = m_nccOnlyCheck->isChecked();
   ablation.localOnly = m_localOnlyCheck->isChecked();
   ablation.cmaesForGenetic = m_cmaesCheck->isChecked();
+  ablation.noTransgraph = m_noTransgraphCheck->isChecked();
   return ablation;
 }
 
@@ -130,6 +135,7 @@ void RegisterStepWidget::setAblation(const RegistrationAblation& ablation) {
   m_nccOnlyCheck->setChecked(ablation.nccOnly);
   m_localOnlyCheck->setChecked(ablation.localOnly);
   m_cmaesCheck->setChecked(ablation.cmaesForGenetic);
+  m_noTransgraphCheck->setChecked(ablation.noTransgraph);
 }
 
 QString RegisterStepWidget::message() const { return m_message->text(); }
@@ -297,7 +303,7 @@ void RegisterStepWidget::setRunningUi(bool running) {
   m_cancelButton->setEnabled(running);
   for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
                                                           m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
-                                                          m_cmaesCheck}) {
+                                                          m_cmaesCheck, m_noTransgraphCheck}) {
     control->setEnabled(!running);
   }
 }

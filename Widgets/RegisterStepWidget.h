@@ -97,6 +97,7 @@ class RegisterStepWidget : public QWidget {
   QCheckBox* m_nccOnlyCheck;
   QCheckBox* m_localOnlyCheck;
   QCheckBox* m_cmaesCheck;
+  QCheckBox* m_noTransgraphCheck;
   QPushButton* m_runButton;
   QPushButton* m_cancelButton;
   QProgressBar* m_progressBar;

@@ -102,3 +102,17 @@ TEST(RegisterStepWidget, AResultOfViewsReplacedDuringTheRunIsNotKept) {
   EXPECT_FALSE(session.document.result().has_value());
   EXPECT_NE(step.message().indexOf(QStringLiteral("changed during the run")), -1) << step.message().toStdString();
 }
+
+TEST(RegisterStepWidget, EveryAblationSwitchIncludingTheTransgraphRoundTrips) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  EXPECT_TRUE(step.ablation().activeNames().empty()) << "every technique on by default";
+  fct::RegistrationAblation all;
+  all.noDynamicRois = all.noPyramid = all.nccOnly = all.localOnly = all.cmaesForGenetic = all.noTransgraph = true;
+  step.setAblation(all);
+  EXPECT_EQ(step.ablation().activeNames(), all.activeNames());
+  fct::RegistrationAblation onlyTransgraphOff;
+  onlyTransgraphOff.noTransgraph = true;
+  step.setAblation(onlyTransgraphOff);
+  EXPECT_EQ(step.ablation().activeNames(), std::vector<std::string>{"no-transgraph"});
+}
