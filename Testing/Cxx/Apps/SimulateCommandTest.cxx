@@ -6,6 +6,7 @@
 
 #include "PoseFile.h"
 #include "TestSupport.h"
+#include "TextFile.h"
 #include "ViewFile.h"
 #include "XrayImageFileReader.h"
 
@@ -34,6 +35,18 @@ void makeInputs(const std::filesystem::path& dir) {
   ASSERT_TRUE(fct::PoseFile::write(pose, dir / "pose.json").ok());
 }
 
+/// The whole text of `path` ("" if unreadable; the expectations on its content then fail).
+std::string fileText(const std::filesystem::path& path) {
+  auto text = fct::TextFile::read(path);
+  return text.ok() ? text.value() : std::string();
+}
+
+/// `simulate` with the inputs of makeInputs(dir) and output folder `out`.
+std::string simulateCommand(const std::filesystem::path& dir, const std::filesystem::path& out) {
+  return fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'", (dir / "ct.nrrd").string(),
+                     (dir / "views.json").string(), (dir / "pose.json").string(), out.string());
+}
+
 }  // namespace
 
 TEST(ViewsCommand, WritesStandardViewsAroundTheCtCentre) {
@@ -58,8 +71,7 @@ TEST(ViewsCommand, ImagesOptionNamesOneImagePerView) {
                                                  (dir / "ct.nrrd").string(), (dir / "named.json").string(),
                                                  (dir / "xray").string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
-  std::ifstream file(dir / "named.json");
-  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::string text = fileText(dir / "named.json");
   EXPECT_NE(text.find("\"path\": \"xray_ap.png\""), std::string::npos) << text;
   EXPECT_NE(text.find("\"path\": \"xray_lateral.png\""), std::string::npos) << text;
 }
@@ -89,8 +101,7 @@ TEST(SimulateCommand, WritesARegistrationCase) {
   auto truth = fct::PoseFile::read(out / "truth_pose.json");
   ASSERT_TRUE(truth.ok()) << truth.error();
   EXPECT_NEAR(truth.value().translation().z(), 3.0, 1e-12);
-  std::ifstream parameters(out / "simulation.json");
-  const std::string text((std::istreambuf_iterator<char>(parameters)), std::istreambuf_iterator<char>());
+  const std::string text = fileText(out / "simulation.json");
   EXPECT_NE(text.find("\"noise_photons\": 2000"), std::string::npos) << text;
   EXPECT_NE(text.find("\"method\": \"raycast\""), std::string::npos) << text;
 }
@@ -99,8 +110,7 @@ TEST(SimulateCommand, FailsCleanlyOnBadInputs) {
   const auto dir = workDir();
   makeInputs(dir);
   const auto out = dir / "case";
-  const std::string base = fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'", (dir / "ct.nrrd").string(),
-                                       (dir / "views.json").string(), (dir / "pose.json").string(), out.string());
+  const std::string base = simulateCommand(dir, out);
   for (const std::string& extra : {std::string(" --method magic"), std::string(" --noise-photons -5"),
                                    std::string(" --i0 70000"), std::string(" --i0 0")}) {
     SCOPED_TRACE(extra);
@@ -159,8 +169,7 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
   auto degraded = fct::test::runCli(fmt::format("info '{}'", (out / "ct_registration.nrrd").string()));
   ASSERT_EQ(degraded.exitCode, 0) << degraded.err;
   EXPECT_NE(degraded.out.find("4 x 4 x 8 mm"), std::string::npos) << degraded.out;
-  std::ifstream parameters(out / "simulation.json");
-  const std::string text((std::istreambuf_iterator<char>(parameters)), std::istreambuf_iterator<char>());
+  const std::string text = fileText(out / "simulation.json");
   EXPECT_NE(text.find("\"model\": \"physical\""), std::string::npos) << text;
   EXPECT_NE(text.find("\"tube_voltage_kvp\": 75"), std::string::npos) << text;
   EXPECT_NE(text.find("\"slice_spacing_mm\": 8"), std::string::npos) << text;
@@ -172,8 +181,7 @@ TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
   const auto dir = workDir();
   makeInputs(dir);
   const auto out = dir / "case";
-  const std::string base = fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'", (dir / "ct.nrrd").string(),
-                                       (dir / "views.json").string(), (dir / "pose.json").string(), out.string());
+  const std::string base = simulateCommand(dir, out);
   for (const std::string& extra :
        {std::string(" --model physical --kvp 200"), std::string(" --model physical --dose -1"),
         std::string(" --model physical --pincushion 0.5"), std::string(" --model physical --method raycast"),
