@@ -97,7 +97,7 @@ Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expecte
   for (const View& view : m_views) {
     auto created = DrrRendererFactory::createForView(m_drrVolume, m_drrOptions, view.camera, T_expected_world_from_ct,
                                                      monitor);
-    if (!created) return fail(fmt::format("view '{}': Transgraph: {}", view.name, created.error()));
+    if (!created) return fail(fmt::format("view '{}': {}", view.name, created.error()));
     for (const std::string& warning : created.warnings()) status.addWarning(fmt::format("view '{}': {}", view.name, warning));
     renderers.push_back(std::move(created).value());
   }

@@ -41,6 +41,14 @@ std::string fileText(const std::filesystem::path& path) {
   return text.ok() ? text.value() : std::string();
 }
 
+/// Runs `command` and expects exit status 2 with exactly one line on stderr starting with "error: ".
+void expectOneErrorLine(const std::string& command) {
+  const auto run = fct::test::runCli(command);
+  EXPECT_EQ(run.exitCode, 2);
+  EXPECT_EQ(run.err.rfind("error: ", 0), 0u) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+}
+
 /// `simulate` with the inputs of makeInputs(dir) and output folder `out`.
 std::string simulateCommand(const std::filesystem::path& dir, const std::filesystem::path& out) {
   return fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'", (dir / "ct.nrrd").string(),
@@ -114,10 +122,7 @@ TEST(SimulateCommand, FailsCleanlyOnBadInputs) {
   for (const std::string& extra : {std::string(" --method magic"), std::string(" --noise-photons -5"),
                                    std::string(" --i0 70000"), std::string(" --i0 0")}) {
     SCOPED_TRACE(extra);
-    const auto run = fct::test::runCli(base + extra);
-    EXPECT_EQ(run.exitCode, 2);
-    EXPECT_EQ(run.err.rfind("error: ", 0), 0u) << run.err;
-    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    expectOneErrorLine(base + extra);
   }
   const auto missingCt = fct::test::runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}'",
                                                        (dir / "nope.nrrd").string(), (dir / "views.json").string(),
@@ -187,10 +192,7 @@ TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
         std::string(" --model physical --pincushion 0.5"), std::string(" --model physical --method raycast"),
         std::string(" --kwires 2"), std::string(" --model xray"), std::string(" --model physical --ct-slice-mm 2")}) {
     SCOPED_TRACE(extra);
-    const auto run = fct::test::runCli(base + extra);
-    EXPECT_EQ(run.exitCode, 2);
-    EXPECT_EQ(run.err.rfind("error: ", 0), 0u) << run.err;
-    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    expectOneErrorLine(base + extra);
   }
   EXPECT_FALSE(std::filesystem::exists(out)) << "failed runs must not create the case folder";
   std::ofstream(dir / "scaled.json") << R"({"T_world_from_ct": [[2,0,0,0],[0,2,0,0],[0,0,2,0],[0,0,0,1]]})";
