@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
 #include <cstdio>
 
 namespace fct::cli {
@@ -19,6 +20,16 @@ bool parseDetectorSize(const std::string& text, int& cols, int& rows) {
   char separator = 0, trailing = 0;
   return std::sscanf(text.c_str(), "%d%c%d%c", &cols, &separator, &rows, &trailing) == 3 &&
          (separator == 'x' || separator == 'X') && cols >= 1 && rows >= 1;
+}
+
+CLI::Validator positiveNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) && value > 0.0) return {};
+        return fmt::format("must be a positive number, got '{}'", text);
+      },
+      "POSITIVE");
 }
 
 }  // namespace fct::cli

@@ -20,6 +20,9 @@ int reportError(const std::string& message);
 /// Parses a detector size "COLSxROWS" (e.g. "800x600", x or X) into pixels; false on anything else or a size below 1.
 bool parseDetectorSize(const std::string& text, int& cols, int& rows);
 
+/// Option check: the value must be a finite number > 0; the message names the value given.
+CLI::Validator positiveNumber();
+
 // Each command file provides a register function: it adds its subcommand to `app` and, when the subcommand is
 // chosen, stores its action in `action` (run after parsing).
 

@@ -156,7 +156,7 @@ void registerDrrCommand(CLI::App& app, CommandAction& action) {
                       "~/.cache/fluoroct/transgraph); 'none' disables the cache");
   command->add_option("--transgraph-spacing-mm", options->transgraphSpacing_mm,
                       "Transgraph plane sampling step in mm (smaller: more accurate, rays grow as step^-4)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   command->add_option("--out", options->out, "Output prefix and format, e.g. out/drr.nrrd -> out/drr_<view>.nrrd")
       ->required();

@@ -359,7 +359,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                       "~/.cache/fluoroct/transgraph); 'none' disables the cache");
   command->add_option("--transgraph-spacing-mm", options->transgraphSpacing_mm,
                       "Transgraph ray sampling step on the planes, mm (offsets 3x; rays grow as spacing^-4)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
   command->add_option("--truth", options->truth,

@@ -157,3 +157,15 @@ TEST(DrrCommand, FailsWithOneErrorLineAndWritesNothingOnBadInput) {
   }
   EXPECT_TRUE(fs::is_empty(f.out)) << "nothing may be written after a failure";
 }
+
+TEST(DrrCommand, RefusesANonPositiveTransgraphSpacingWithOneErrorLine) {
+  const DrrFixture f;
+  for (const char* spacing : {"0", "-3", "abc"}) {
+    SCOPED_TRACE(spacing);
+    const auto run = fct::test::runCli(f.baseArguments() + fmt::format(" --method transgraph --transgraph-spacing-mm {} --out '{}'",
+                                                                      spacing, (f.out / "tg.tif").string()));
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_NE(run.err.find("--transgraph-spacing-mm: must be a positive number"), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(f.out / "tg_AP.tif"));
+  }
+}
