@@ -2,8 +2,10 @@
 
 #include <fmt/core.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -43,6 +45,37 @@ Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& opt
   if (nonFinite > 0) {
     return fail(fmt::format("the CT has {} voxels that are NaN or infinite; repair or re-export the volume", nonFinite));
   }
+  volume.findContentBox();
+  return volume;
+}
+
+Result<DrrVolume> DrrVolume::coarsened(const Eigen::Vector3i& blockSize_ijk) const {
+  if ((blockSize_ijk.array() < 1).any()) {
+    return fail(fmt::format("CT block size must be at least 1 voxel per axis, got {}x{}x{}", blockSize_ijk.x(),
+                            blockSize_ijk.y(), blockSize_ijk.z()));
+  }
+  const Eigen::Vector3i& fine = dims();
+  const Eigen::Vector3i coarse = (fine + blockSize_ijk - Eigen::Vector3i::Ones()).cwiseQuotient(blockSize_ijk);
+  // The first coarse voxel's centre is the centre of its block's voxels.
+  const Eigen::Vector3d firstCentre_ijk = 0.5 * (blockSize_ijk - Eigen::Vector3i::Ones()).cast<double>();
+  auto grid = Volume::create(coarse, m_values.spacing_mm().cwiseProduct(blockSize_ijk.cast<double>()),
+                             m_values.lpsFromIjk(firstCentre_ijk), m_values.direction_lps());
+  if (!grid) return fail("coarse CT: " + grid.error());
+  DrrVolume volume;
+  volume.m_values = std::move(grid).value();
+  volume.m_options = m_options;
+  volume.m_T_ct_from_ijk = volume.m_values.T_lps_from_ijk();
+  volume.m_T_ijk_from_ct = volume.m_values.T_ijk_from_lps();
+  const float weight = 1.0f / static_cast<float>(blockSize_ijk.prod());
+  tbb::parallel_for(0, coarse.z(), [&](int K) {
+    for (int k = K * blockSize_ijk.z(); k < std::min(fine.z(), (K + 1) * blockSize_ijk.z()); ++k) {
+      for (int j = 0; j < fine.y(); ++j) {
+        const float* row = data() + m_values.offset(0, j, k);
+        float* coarseRow = &volume.m_values.at(0, j / blockSize_ijk.y(), K);
+        for (int i = 0; i < fine.x(); ++i) coarseRow[i / blockSize_ijk.x()] += weight * row[i];
+      }
+    }
+  });
   volume.findContentBox();
   return volume;
 }

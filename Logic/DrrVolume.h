@@ -38,6 +38,13 @@ class DrrVolume {
   /// Converts a CT once. Fails on an empty volume, non-finite voxels, or a non-positive or non-finite µ_water.
   static Result<DrrVolume> create(const Volume& ct, const DrrValueOptions& options = {});
 
+  /// The values box-averaged over blocks of blockSize_ijk voxels (each >= 1): coarse voxel (I,J,K) is the mean of
+  /// voxels [I·b, I·b + b - 1] per axis, where voxels beyond the volume count as 0 (air for attenuation values), so
+  /// the coarse grid covers the volume rounded up to whole blocks. Same options and frame; spacing times the block.
+  /// A line integral through the result equals one through the original CT blurred by the block (less traversal
+  /// work: the coarse pyramid levels of registration use it). Fails on a block size below 1.
+  Result<DrrVolume> coarsened(const Eigen::Vector3i& blockSize_ijk) const;
+
   /// Parses "attenuation" or "raw"; the error lists the accepted names.
   static Result<DrrValueKind> parseValueKind(std::string_view name);
   /// The name parseValueKind() accepts for `kind`.

@@ -85,7 +85,9 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
   // registration at once instead of after the earlier stages' work.
   std::vector<RegistrationObjective> objectives;
   for (const RegistrationStage& stage : schedule.stages) {
-    auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr);
+    auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
+                                                 options.ablation.noCtPyramid ? std::nullopt
+                                                                              : std::optional(T_initial));
     if (!created) return fail(created.error());
     objectives.push_back(std::move(created).value());
   }

@@ -27,6 +27,7 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   auto renderer = DrrRendererFactory::create(result.m_drrVolume, exact);
   if (!renderer) return fail(renderer.error());
   result.m_renderer = std::move(renderer).value();
+  result.m_exactOptions = exact;
   result.m_viewRenderersReady = options.drr.method != DrrMethod::Transgraph;
 
   for (const RegistrationView& view : views) {
@@ -108,6 +109,39 @@ Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expecte
   m_viewRenderersReady = true;
   m_viewRendererSetup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return status;
+}
+
+Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const {
+  const Camera levelCamera = m_views[v].camera.downsampled(level);
+  const CameraIntrinsics& in = levelCamera.intrinsics();
+  const double depth_mm = (levelCamera.T_camera_from_world() * T_world_from_ct * m_centre_ct_mm).z();
+  const double footprint_mm = in.pixelSpacing_mm.minCoeff() * depth_mm / in.sourceToDetector_mm;
+  const Eigen::Vector3d& spacing_mm = m_drrVolume->values().spacing_mm();
+  Eigen::Vector3i block;
+  for (int a = 0; a < 3; ++a) block[a] = std::max(1, static_cast<int>(std::floor(footprint_mm / spacing_mm[a])));
+  return block;
+}
+
+Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int level,
+                                                           const Eigen::Isometry3d& T_world_from_ct) {
+  if (v >= m_views.size()) return fail(fmt::format("view index {} out of range (there are {})", v, m_views.size()));
+  if (level < 0 || level >= levelCount()) {
+    return fail(fmt::format("view '{}': pyramid level {} does not exist; use 0 to {}", m_views[v].name, level,
+                            levelCount() - 1));
+  }
+  const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct);
+  if ((block.array() == 1).all()) return m_renderer.get();
+  const std::array<int, 3> key{block.x(), block.y(), block.z()};
+  auto found = m_coarseRenderers.find(key);
+  if (found == m_coarseRenderers.end()) {
+    auto coarse = m_drrVolume->coarsened(block);
+    if (!coarse) return fail(coarse.error());
+    auto renderer = DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(coarse).value()),
+                                               m_exactOptions);
+    if (!renderer) return fail(renderer.error());
+    found = m_coarseRenderers.emplace(key, std::move(renderer).value()).first;
+  }
+  return found->second.get();
 }
 
 Result<const DynamicRoiSelector*> RegistrationCase::selector(std::size_t v, int level, int windowSize) {

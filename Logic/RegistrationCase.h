@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -69,6 +70,15 @@ class RegistrationCase {
 
   /// The exact DRR renderer shared by all views: the method's renderer, Siddon for the transgraph method.
   const DrrRenderer& renderer() const { return *m_renderer; }
+  /// The exact renderer for view v at pyramid `level` with the CT near pose T_world_from_ct: renderer()'s method over
+  /// the CT box-averaged to the level's pixel footprint (ctBlockSize()), so coarse levels traverse fewer, larger voxels
+  /// and their DRRs carry the blur of their pixels; renderer() itself where the block is one voxel. Coarse CTs are
+  /// made on first use and kept. Fails on a bad view or level.
+  Result<const DrrRenderer*> levelRenderer(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct);
+  /// The CT voxels per axis that levelRenderer() averages for view v at `level`: floor(pixel footprint / voxel
+  /// spacing), at least 1, where the footprint is the level's smaller pixel side scaled to the depth of the rotation
+  /// centre at T_world_from_ct (the pixel's size at the bone).
+  Eigen::Vector3i ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const;
   /// The renderer of view v: its Transgraph once built (transgraph method), else renderer().
   const DrrRenderer& renderer(std::size_t v) const { return *m_views[v].renderer; }
   /// The Transgraph renderer of view v, or null (other method, or tables not built yet).
@@ -132,6 +142,8 @@ class RegistrationCase {
 
   std::shared_ptr<const DrrVolume> m_drrVolume;
   std::shared_ptr<const DrrRenderer> m_renderer;
+  DrrRendererOptions m_exactOptions;                                          ///< options of m_renderer
+  std::map<std::array<int, 3>, std::shared_ptr<const DrrRenderer>> m_coarseRenderers;  ///< by CT block size
   DrrRendererOptions m_drrOptions;
   bool m_viewRenderersReady = true;
   double m_viewRendererSetup_s = 0.0;

@@ -29,7 +29,8 @@ PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int maxPixels) {
 }  // namespace
 
 Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
-                                                            const RegistrationStage& stage, bool useViewRenderers) {
+                                                            const RegistrationStage& stage, bool useViewRenderers,
+                                                            const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct) {
   RegistrationObjective objective;
   objective.m_level = stage.level;
   const int level = stage.level;
@@ -44,6 +45,11 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
     View view;
     view.renderer = useViewRenderers ? &registrationCase.renderer(v) : &registrationCase.renderer();
     view.transgraph = useViewRenderers ? registrationCase.transgraph(v) : nullptr;
+    if (!view.transgraph && T_coarseCt_world_from_ct) {
+      auto levelRenderer = registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct);
+      if (!levelRenderer) return fail(fmt::format("{}: {}", where(v), levelRenderer.error()));
+      view.renderer = levelRenderer.value();
+    }
     view.camera = registrationCase.camera(v);
     const std::size_t validCount = pyramidLevel.mask.validCount();
 

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -27,9 +28,12 @@ class RegistrationObjective {
  public:
   /// Builds the pixel sets and the X-ray side of the metric of every view for `stage`. Fails, naming the stage and
   /// view, on a level the pyramid lacks or a pixel set that cannot be built (no complete valid window, ...).
-  /// With useViewRenderers false every view uses the case's exact renderer (the Transgraph switched off).
-  static Result<RegistrationObjective> create(RegistrationCase& registrationCase, const RegistrationStage& stage,
-                                              bool useViewRenderers = true);
+  /// With useViewRenderers false every view uses the case's exact renderer (the Transgraph switched off). Exact
+  /// renderers integrate the full CT, or, given T_coarseCt_world_from_ct, the CT coarsened to the stage level's pixel
+  /// footprint at that pose (RegistrationCase::levelRenderer; the CT pyramid).
+  static Result<RegistrationObjective> create(
+      RegistrationCase& registrationCase, const RegistrationStage& stage, bool useViewRenderers = true,
+      const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct = std::nullopt);
 
   /// S(T) in [-1, 1] for the CT at T_world_from_ct (see the file comment). Fails on a rendering or metric error.
   Result<double> similarity(const Eigen::Isometry3d& T_world_from_ct);

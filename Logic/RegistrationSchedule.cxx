@@ -141,6 +141,7 @@ std::vector<std::string> RegistrationAblation::activeNames() const {
   if (localOnly) names.emplace_back("local-only");
   if (cmaesForGenetic) names.emplace_back("cmaes");
   if (noTransgraph) names.emplace_back("no-transgraph");
+  if (noCtPyramid) names.emplace_back("no-ct-pyramid");
   return names;
 }
 

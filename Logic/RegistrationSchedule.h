@@ -67,6 +67,7 @@ struct RegistrationAblation {
   bool localOnly = false;          ///< every global search replaced by the local simplex
   bool cmaesForGenetic = false;    ///< CMA-ES wherever the schedule says genetic
   bool noTransgraph = false;       ///< exact (Siddon) DRRs instead of the per-view Transgraphs (transgraph method)
+  bool noCtPyramid = false;        ///< exact DRRs of every level integrate the full CT (not one coarsened to the level)
 
   /// Names of the switches that are on, for reports ("no-rois", "no-pyramid", ...).
   std::vector<std::string> activeNames() const;

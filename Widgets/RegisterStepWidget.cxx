@@ -53,8 +53,11 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   m_localOnlyCheck = new QCheckBox(tr("Global search (local simplex only)"), ablationBox);
   m_cmaesCheck = new QCheckBox(tr("Genetic search (CMA-ES instead)"), ablationBox);
   m_noTransgraphCheck = new QCheckBox(tr("Transgraph (exact DRRs instead of the tables)"), ablationBox);
-  for (QCheckBox* check :
-       {m_noRoisCheck, m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck, m_cmaesCheck, m_noTransgraphCheck}) {
+  m_noCtPyramidCheck = new QCheckBox(tr("CT pyramid (coarse levels ray-cast the full CT)"), ablationBox);
+  m_noCtPyramidCheck->setToolTip(tr("By default the DRRs of a coarse pyramid level integrate the CT averaged to the "
+                                    "level's pixel size at the bone (faster on thin-slice CTs)"));
+  for (QCheckBox* check : {m_noRoisCheck, m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck, m_cmaesCheck,
+                           m_noTransgraphCheck, m_noCtPyramidCheck}) {
     ablationLayout->addWidget(check);
   }
   layout->addWidget(ablationBox);
@@ -126,6 +129,7 @@ RegistrationAblation RegisterStepWidget::ablation() const {
   ablation.localOnly = m_localOnlyCheck->isChecked();
   ablation.cmaesForGenetic = m_cmaesCheck->isChecked();
   ablation.noTransgraph = m_noTransgraphCheck->isChecked();
+  ablation.noCtPyramid = m_noCtPyramidCheck->isChecked();
   return ablation;
 }
 
@@ -136,6 +140,7 @@ void RegisterStepWidget::setAblation(const RegistrationAblation& ablation) {
   m_localOnlyCheck->setChecked(ablation.localOnly);
   m_cmaesCheck->setChecked(ablation.cmaesForGenetic);
   m_noTransgraphCheck->setChecked(ablation.noTransgraph);
+  m_noCtPyramidCheck->setChecked(ablation.noCtPyramid);
 }
 
 QString RegisterStepWidget::message() const { return m_message->text(); }
@@ -303,7 +308,7 @@ void RegisterStepWidget::setRunningUi(bool running) {
   m_cancelButton->setEnabled(running);
   for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
                                                           m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
-                                                          m_cmaesCheck, m_noTransgraphCheck}) {
+                                                          m_cmaesCheck, m_noTransgraphCheck, m_noCtPyramidCheck}) {
     control->setEnabled(!running);
   }
 }

@@ -98,6 +98,7 @@ class RegisterStepWidget : public QWidget {
   QCheckBox* m_localOnlyCheck;
   QCheckBox* m_cmaesCheck;
   QCheckBox* m_noTransgraphCheck;
+  QCheckBox* m_noCtPyramidCheck;
   QPushButton* m_runButton;
   QPushButton* m_cancelButton;
   QProgressBar* m_progressBar;

@@ -386,6 +386,9 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_flag("--cmaes", options->ablation.cmaesForGenetic, "CMA-ES instead of the genetic search");
   command->add_flag("--no-transgraph", options->ablation.noTransgraph,
                     "Ablation: exact (Siddon) DRRs instead of the Transgraph tables (no table is built)");
+  command->add_flag("--no-ct-pyramid", options->ablation.noCtPyramid,
+                    "Exact DRRs of coarse pyramid levels integrate the full CT instead of one box-averaged to the "
+                    "level's pixel size at the bone");
   command->callback([&action, options] { action = [options] { return runRegister(*options); }; });
 }
 

@@ -158,14 +158,15 @@ TEST(RegisterCommand, RegistersWithTransgraphTablesCachedForTheNextRun) {
   ASSERT_TRUE(registered.ok()) << registered.error();
   EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 0.5);
 
-  // The ablation switch: exact DRRs, no table needed.
-  run = fct::test::runCli(command + " --no-transgraph --local-only");
+  // The ablation switch: exact DRRs, no table needed (and every level's DRRs from the full CT).
+  run = fct::test::runCli(command + " --no-transgraph --local-only --no-ct-pyramid");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   result = fct::JsonDocument::parse(dir / "result.json");
   ASSERT_TRUE(result.ok()) << result.error();
   EXPECT_EQ(result.value()["options"]["method"], "siddon");
   EXPECT_TRUE(result.value()["transgraph"].is_null());
   EXPECT_EQ(result.value()["options"]["ablation"][1], "no-transgraph");
+  EXPECT_EQ(result.value()["options"]["ablation"][2], "no-ct-pyramid");
 }
 
 TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {

@@ -74,6 +74,44 @@ TEST(DrrVolume, RejectsEmptyCtNonFiniteVoxelsAndBadWaterAttenuation) {
   EXPECT_FALSE(fct::DrrVolume::create(fourVoxelCt(), options).ok());
 }
 
+TEST(DrrVolume, CoarsenedAveragesBlocksWithAirBeyondTheEdgeAndKeepsTheFrame) {
+  Eigen::Matrix3d direction;
+  direction << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // a rotation: i along +P, j along -L
+  fct::Volume ct = fct::Volume::create({5, 4, 3}, {0.5, 0.7, 2.0}, {10, 20, 30}, direction).value();
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 5; ++i) ct.at(i, j, k) = static_cast<float>(i + 10 * j + 100 * k);
+  fct::DrrValueOptions raw;
+  raw.kind = fct::DrrValueKind::Raw;
+  const fct::DrrVolume fine = fct::DrrVolume::create(ct, raw).value();
+  const auto coarse = fine.coarsened({2, 2, 1});
+  ASSERT_TRUE(coarse.ok()) << coarse.error();
+  const fct::Volume& c = coarse.value().values();
+  EXPECT_EQ(c.dims(), Eigen::Vector3i(3, 2, 3)) << "5 voxels in blocks of 2 round up to 3";
+  EXPECT_EQ(c.spacing_mm(), Eigen::Vector3d(1.0, 1.4, 2.0));
+  EXPECT_FLOAT_EQ(c.at(0, 0, 0), (0 + 1 + 10 + 11) / 4.0f);
+  EXPECT_FLOAT_EQ(c.at(1, 1, 2), (222 + 223 + 232 + 233) / 4.0f);
+  EXPECT_FLOAT_EQ(c.at(2, 0, 1), (104 + 114) / 4.0f) << "the missing column counts as 0";
+  // A coarse voxel's centre is the centroid of its block's voxel centres, in the same CT frame.
+  EXPECT_NEAR((c.lpsFromIjk({1, 1, 2}) - ct.lpsFromIjk({2.5, 2.5, 2.0})).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((coarse.value().T_ct_from_ijk() * Eigen::Vector3d(1, 1, 2) - ct.lpsFromIjk({2.5, 2.5, 2.0})).norm(), 0.0,
+              1e-12);
+  EXPECT_EQ(coarse.value().options().kind, fct::DrrValueKind::Raw);
+  EXPECT_FALSE(fine.coarsened({0, 1, 1}).ok());
+  EXPECT_NE(fine.coarsened({1, 1, -2}).error().find("at least 1"), std::string::npos);
+}
+
+TEST(DrrVolume, CoarsenedKeepsTheTotalAttenuation) {
+  fct::Volume ct = fct::Volume::create({12, 9, 8}, {0.45, 0.45, 1.0}).value();
+  for (std::size_t n = 0; n < ct.voxels().size(); ++n) ct.voxels()[n] = static_cast<float>((n * 7919) % 2400) - 1000.0f;
+  const fct::DrrVolume fine = fct::DrrVolume::create(ct).value();
+  const fct::DrrVolume coarse = fine.coarsened({4, 3, 2}).value();
+  double fineSum = 0.0, coarseSum = 0.0;
+  for (const float v : fine.values().voxels()) fineSum += v;
+  for (const float v : coarse.values().voxels()) coarseSum += v;
+  EXPECT_NEAR(coarseSum * 24.0, fineSum, 1e-5 * fineSum) << "attenuation x volume is kept";
+}
+
 TEST(DrrVolume, ParsesValueKindNames) {
   for (const auto kind : {fct::DrrValueKind::Attenuation, fct::DrrValueKind::Raw}) {
     const auto parsed = fct::DrrVolume::parseValueKind(fct::DrrVolume::valueKindName(kind));

@@ -291,3 +291,49 @@ TEST(RegistrationCase, RotatesAboutTheBoneCentroidWithScalesFromItsRadius) {
   EXPECT_EQ(a.value().pixels, b.value().pixels);
   EXPECT_NEAR(a.value().keptFraction, 0.12, 0.04);
 }
+
+TEST(Registration, CtPyramidCoarsensTheCtOnlyWherePixelsSpanSeveralVoxels) {
+  Prepared p = preparePhantom();  // 2 mm voxels; 192 px at 1.6 mm, source-isocentre 700 mm of 1000 mm
+  fct::RegistrationCase& rc = p.registrationCase;
+  const Eigen::Isometry3d& T = p.simulated.T_truth;
+  // Level 0: a 1.6 mm pixel is 1.12 mm at the bone (< 1 voxel). Level 2: 6.4 mm -> 4.48 mm, two 2 mm voxels.
+  EXPECT_EQ(rc.ctBlockSize(0, 0, T), Eigen::Vector3i(1, 1, 1));
+  EXPECT_EQ(rc.ctBlockSize(0, 2, T), Eigen::Vector3i(2, 2, 2));
+  EXPECT_EQ(rc.levelRenderer(0, 0, T).value(), &rc.renderer());
+  const fct::DrrRenderer* coarse = rc.levelRenderer(0, 2, T).value();
+  ASSERT_NE(coarse, &rc.renderer());
+  EXPECT_EQ(coarse->volume().values().spacing_mm(), Eigen::Vector3d(4.0, 4.0, 4.0));
+  EXPECT_EQ(rc.levelRenderer(1, 2, T).value(), coarse) << "views share a coarse CT of the same block";
+  EXPECT_FALSE(rc.levelRenderer(0, rc.levelCount(), T).ok());
+
+  // The coarse DRR is the full CT's DRR blurred by about one pixel: nearly the same image.
+  const fct::FloatImage full = rc.renderer().render(rc.camera(0), T, 2).value();
+  const fct::FloatImage blurred = coarse->render(rc.camera(0), T, 2).value();
+  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  const double n = static_cast<double>(full.pixels.size());
+  for (std::size_t i = 0; i < full.pixels.size(); ++i) {
+    const double a = full.pixels[i], b = blurred.pixels[i];
+    sa += a, sb += b, saa += a * a, sbb += b * b, sab += a * b;
+  }
+  const double ncc = (sab - sa * sb / n) / std::sqrt((saa - sa * sa / n) * (sbb - sb * sb / n));
+  EXPECT_GT(ncc, 0.995);
+  EXPECT_NEAR(sb / sa, 1.0, 0.02) << "the total attenuation seen is kept";
+}
+
+TEST(Registration, WithoutTheCtPyramidTheSameStartConvergesAsWell) {
+  Prepared p = preparePhantom();
+  const Eigen::Isometry3d start = fct::test::startPose(p.registrationCase, p.simulated.T_truth, 10.0, 77);
+  fct::RegistrationOptions options = fastOptions(77);
+  auto pyramid = fct::Registration::run(p.registrationCase, start, options);
+  options.ablation.noCtPyramid = true;
+  auto fullCt = fct::Registration::run(p.registrationCase, start, options);
+  ASSERT_TRUE(pyramid.ok()) << pyramid.error();
+  ASSERT_TRUE(fullCt.ok()) << fullCt.error();
+  std::printf("CT pyramid %.3f mm in %.2f s; full CT %.3f mm in %.2f s\n", errorOf(p, pyramid.value().T_world_from_ct),
+              pyramid.value().totalSeconds, errorOf(p, fullCt.value().T_world_from_ct), fullCt.value().totalSeconds);
+  EXPECT_LT(errorOf(p, pyramid.value().T_world_from_ct), 0.5);
+  EXPECT_LT(errorOf(p, fullCt.value().T_world_from_ct), 0.5);
+  EXPECT_NE(fullCt.value().schedule.name.find("no-ct-pyramid"), std::string::npos) << fullCt.value().schedule.name;
+  EXPECT_NE(pyramid.value().T_world_from_ct.matrix(), fullCt.value().T_world_from_ct.matrix())
+      << "the switch changes the coarse levels' DRRs";
+}

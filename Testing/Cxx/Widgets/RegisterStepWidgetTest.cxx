@@ -108,7 +108,8 @@ TEST(RegisterStepWidget, EveryAblationSwitchIncludingTheTransgraphRoundTrips) {
   fct::RegisterStepWidget step(&session.document);
   EXPECT_TRUE(step.ablation().activeNames().empty()) << "every technique on by default";
   fct::RegistrationAblation all;
-  all.noDynamicRois = all.noPyramid = all.nccOnly = all.localOnly = all.cmaesForGenetic = all.noTransgraph = true;
+  all.noDynamicRois = all.noPyramid = all.nccOnly = all.localOnly = all.cmaesForGenetic = all.noTransgraph =
+      all.noCtPyramid = true;
   step.setAblation(all);
   EXPECT_EQ(step.ablation().activeNames(), all.activeNames());
   fct::RegistrationAblation onlyTransgraphOff;
