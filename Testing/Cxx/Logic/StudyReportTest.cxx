@@ -64,8 +64,12 @@ TEST(StudyReport, CaptureReportGivesCumulativeFailureAndTheRange) {
   for (int t = 0; t < 2; ++t) {
     records.push_back(trial("capture", "phantom/both/00-10mm", t, 0.2, 1.0));
     records.push_back(trial("capture", "phantom/both/10-20mm", t, t == 0 ? 0.2 : 8.0, 1.0));
+    records.push_back(trial("capture", "phantom/ncc-only/00-10mm", t, 0.2, 1.0));
+    records.push_back(trial("capture", "phantom/ncc-only/10-20mm", t, 0.3, 1.0));
   }
   const std::string text = fct::StudyReport::markdown(study, records, {});
   EXPECT_NE(text.find("| 10–20 | 2 | 50 % (1/2) | 25 % |"), std::string::npos) << text;
   EXPECT_NE(text.find("| phantom | both | 10 |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| phantom | ncc-only | ≥ 20 (every bin tested) |"), std::string::npos)
+      << "no bin failed, so the range is only a lower bound\n" << text;
 }
