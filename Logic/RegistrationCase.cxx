@@ -11,6 +11,16 @@
 
 namespace fct {
 
+namespace {
+
+/// The options of the exact renderer: the method's own, or Siddon under the per-view Transgraphs.
+DrrRendererOptions exactRendererOptions(DrrRendererOptions options) {
+  if (options.method == DrrMethod::Transgraph) options.method = DrrMethod::Siddon;
+  return options;
+}
+
+}  // namespace
+
 Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::vector<RegistrationView>& views,
                                                   const RegistrationCaseOptions& options,
                                                   const ProgressMonitor& monitor) {
@@ -21,13 +31,9 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   if (!drrVolume) return fail("CT: " + drrVolume.error());
   result.m_drrVolume = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
   result.m_drrOptions = options.drr;
-  // The exact renderer: the method's own, or Siddon under the per-view Transgraphs.
-  DrrRendererOptions exact = options.drr;
-  if (exact.method == DrrMethod::Transgraph) exact.method = DrrMethod::Siddon;
-  auto renderer = DrrRendererFactory::create(result.m_drrVolume, exact);
+  auto renderer = DrrRendererFactory::create(result.m_drrVolume, exactRendererOptions(options.drr));
   if (!renderer) return fail(renderer.error());
   result.m_renderer = std::move(renderer).value();
-  result.m_exactOptions = exact;
   result.m_viewRenderersReady = options.drr.method != DrrMethod::Transgraph;
 
   for (const RegistrationView& view : views) {
@@ -111,7 +117,8 @@ Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expecte
   return status;
 }
 
-Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const {
+Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level,
+                                              const Eigen::Isometry3d& T_world_from_ct) const {
   const Camera levelCamera = m_views[v].camera.downsampled(level);
   const CameraIntrinsics& in = levelCamera.intrinsics();
   const double depth_mm = (levelCamera.T_camera_from_world() * T_world_from_ct * m_centre_ct_mm).z();
@@ -124,11 +131,7 @@ Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level, const Ei
 
 Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int level,
                                                            const Eigen::Isometry3d& T_world_from_ct) {
-  if (v >= m_views.size()) return fail(fmt::format("view index {} out of range (there are {})", v, m_views.size()));
-  if (level < 0 || level >= levelCount()) {
-    return fail(fmt::format("view '{}': pyramid level {} does not exist; use 0 to {}", m_views[v].name, level,
-                            levelCount() - 1));
-  }
+  if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
   const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct);
   if ((block.array() == 1).all()) return m_renderer.get();
   const std::array<int, 3> key{block.x(), block.y(), block.z()};
@@ -137,20 +140,26 @@ Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int le
     auto coarse = m_drrVolume->coarsened(block);
     if (!coarse) return fail(coarse.error());
     auto renderer = DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(coarse).value()),
-                                               m_exactOptions);
+                                               exactRendererOptions(m_drrOptions));
     if (!renderer) return fail(renderer.error());
     found = m_coarseRenderers.emplace(key, std::move(renderer).value()).first;
   }
   return found->second.get();
 }
 
-Result<const DynamicRoiSelector*> RegistrationCase::selector(std::size_t v, int level, int windowSize) {
+Status RegistrationCase::checkViewLevel(std::size_t v, int level) const {
   if (v >= m_views.size()) return fail(fmt::format("view index {} out of range (there are {})", v, m_views.size()));
-  View& view = m_views[v];
-  if (level < 0 || level >= view.prepared.pyramid.levelCount()) {
-    return fail(fmt::format("view '{}': pyramid level {} does not exist; use 0 to {}", view.name, level,
-                            view.prepared.pyramid.levelCount() - 1));
+  const int levels = m_views[v].prepared.pyramid.levelCount();
+  if (level < 0 || level >= levels) {
+    return fail(fmt::format("view '{}': pyramid level {} does not exist; use 0 to {}", m_views[v].name, level,
+                            levels - 1));
   }
+  return Ok{};
+}
+
+Result<const DynamicRoiSelector*> RegistrationCase::selector(std::size_t v, int level, int windowSize) {
+  if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
+  View& view = m_views[v];
   const auto key = std::make_pair(level, windowSize);
   auto found = view.selectors.find(key);
   if (found == view.selectors.end()) {

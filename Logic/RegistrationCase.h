@@ -77,7 +77,7 @@ class RegistrationCase {
   Result<const DrrRenderer*> levelRenderer(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct);
   /// The CT voxels per axis that levelRenderer() averages for view v at `level`: floor(pixel footprint / voxel
   /// spacing), at least 1, where the footprint is the level's smaller pixel side scaled to the depth of the rotation
-  /// centre at T_world_from_ct (the pixel's size at the bone).
+  /// centre at T_world_from_ct (the pixel's size at the bone). v and level must be valid (levelRenderer checks them).
   Eigen::Vector3i ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const;
   /// The renderer of view v: its Transgraph once built (transgraph method), else renderer().
   const DrrRenderer& renderer(std::size_t v) const { return *m_views[v].renderer; }
@@ -137,12 +137,13 @@ class RegistrationCase {
     std::shared_ptr<const DrrRenderer> renderer;                  ///< the view's renderer (see renderer(v))
     const TransgraphRenderer* transgraph = nullptr;               ///< the same renderer when it is a Transgraph
   };
+  /// Fails, naming the view, unless v is a view index and level one of its pyramid levels.
+  Status checkViewLevel(std::size_t v, int level) const;
   /// The ROI statistics of view v at (level, window), computed on first use.
   Result<const DynamicRoiSelector*> selector(std::size_t v, int level, int windowSize);
 
   std::shared_ptr<const DrrVolume> m_drrVolume;
   std::shared_ptr<const DrrRenderer> m_renderer;
-  DrrRendererOptions m_exactOptions;                                          ///< options of m_renderer
   std::map<std::array<int, 3>, std::shared_ptr<const DrrRenderer>> m_coarseRenderers;  ///< by CT block size
   DrrRendererOptions m_drrOptions;
   bool m_viewRenderersReady = true;
