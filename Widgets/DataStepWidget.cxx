@@ -17,7 +17,7 @@
 
 #include <optional>
 
-#include "PoseFile.h"
+#include "IO/Project/PoseFile.h"
 #include "StudioDocument.h"
 
 namespace fct {

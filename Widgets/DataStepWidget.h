@@ -13,8 +13,8 @@
 #include <memory>
 #include <vector>
 
-#include "DicomSeriesReader.h"
-#include "Result.h"
+#include "Base/Result.h"
+#include "IO/Dicom/DicomSeriesReader.h"
 
 class QComboBox;
 class QLabel;

@@ -16,7 +16,7 @@
 #include <optional>
 #include <vector>
 
-#include "FloatImage.h"
+#include "Image/FloatImage.h"
 
 namespace fct {
 

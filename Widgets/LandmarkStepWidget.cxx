@@ -13,9 +13,9 @@
 #include <cmath>
 #include <map>
 
-#include "BoneSurface.h"
-#include "LandmarkFile.h"
-#include "SetupPose.h"
+#include "Image/BoneSurface.h"
+#include "InitialPose/SetupPose.h"
+#include "IO/Project/LandmarkFile.h"
 #include "SliceViewWidget.h"
 #include "StudioDocument.h"
 #include "XrayViewWidget.h"

@@ -15,7 +15,7 @@
 #include <optional>
 #include <vector>
 
-#include "LandmarkPoseEstimator.h"
+#include "InitialPose/LandmarkPoseEstimator.h"
 
 class QLabel;
 class QPushButton;

@@ -12,7 +12,7 @@
 #include <array>
 #include <vector>
 
-#include "Registration.h"
+#include "Registration/Registration.h"
 
 class QCheckBox;
 class QComboBox;

@@ -11,7 +11,7 @@
 #include <atomic>
 #include <memory>
 
-#include "Registration.h"
+#include "Registration/Registration.h"
 
 namespace fct {
 

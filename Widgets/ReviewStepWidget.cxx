@@ -19,8 +19,8 @@
 
 #include <algorithm>
 
-#include "ItkTransformFile.h"
-#include "PoseFile.h"
+#include "IO/Project/ItkTransformFile.h"
+#include "IO/Project/PoseFile.h"
 #include "StudioDocument.h"
 #include "XrayViewWidget.h"
 

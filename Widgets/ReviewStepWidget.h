@@ -17,9 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "BoneSurface.h"
-#include "ContourOverlay.h"
-#include "Volume.h"
+#include "Evaluation/ContourOverlay.h"
+#include "Image/BoneSurface.h"
+#include "Image/Volume.h"
 
 class QCheckBox;
 class QComboBox;

@@ -16,7 +16,7 @@
 #include <optional>
 #include <vector>
 
-#include "DynamicRoiSelector.h"
+#include "Similarity/DynamicRoiSelector.h"
 #include "StudioDocument.h"
 
 class QCheckBox;

@@ -8,7 +8,7 @@
 
 #include <filesystem>
 
-#include "Result.h"
+#include "Base/Result.h"
 
 namespace fct {
 

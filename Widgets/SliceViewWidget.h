@@ -12,8 +12,8 @@
 #include <memory>
 #include <vector>
 
+#include "Image/Volume.h"
 #include "ImageViewWidget.h"
-#include "Volume.h"
 
 namespace fct {
 

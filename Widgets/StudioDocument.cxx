@@ -5,11 +5,11 @@
 #include <set>
 #include <utility>
 
-#include "CtLoader.h"
-#include "DrrRendererFactory.h"
-#include "PoseFile.h"
-#include "ViewFile.h"
-#include "XrayLoader.h"
+#include "Drr/DrrRendererFactory.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Volume/CtLoader.h"
+#include "IO/Xray/XrayLoader.h"
 
 namespace fct {
 
@@ -80,8 +80,8 @@ Result<LoadedViews> StudioDocument::readViews(const fs::path& viewFile) {
                               viewFile.string(), spec.name, view.xray.cols, view.xray.rows,
                               spec.camera.intrinsics().cols, spec.camera.intrinsics().rows));
     }
-    for (const CalibrationSphere& sphere : spec.calibrationSpheres) {
-      view.spheres.push_back(PixelCircle{sphere.center_px, sphere.radius_px});
+    for (const PixelCircle& sphere : spec.calibrationSpheres) {
+      view.spheres.push_back(PixelCircle{sphere.centre_px, sphere.radius_px});
     }
     views.push_back(std::move(view));
   }

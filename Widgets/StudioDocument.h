@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-#include "DicomSeriesReader.h"
-#include "Landmarks.h"
-#include "Registration.h"
-#include "RegistrationCase.h"
-#include "Result.h"
-#include "Volume.h"
+#include "Base/Result.h"
+#include "Geometry/Landmarks.h"
+#include "Image/Volume.h"
+#include "IO/Dicom/DicomSeriesReader.h"
+#include "Registration/Registration.h"
+#include "Registration/RegistrationCase.h"
 
 namespace fct {
 

@@ -4,10 +4,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "JsonDocument.h"
-#include "JsonReader.h"
-#include "RegistrationStagesJson.h"
-#include "RigidPose.h"
+#include "Base/JsonDocument.h"
+#include "Base/JsonReader.h"
+#include "Geometry/RigidPose.h"
+#include "Registration/RegistrationStagesJson.h"
 
 namespace fct {
 

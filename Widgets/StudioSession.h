@@ -7,7 +7,7 @@
 
 #include <filesystem>
 
-#include "Result.h"
+#include "Base/Result.h"
 #include "StudioDocument.h"
 
 namespace fct {

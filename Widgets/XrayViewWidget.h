@@ -2,8 +2,8 @@
 // XrayViewWidget: the view of one C-arm X-ray: an ImageViewWidget (window/level, zoom, pan, overlay layers, click and
 // drag signals in detector pixels) that takes XrayImage frames.
 
+#include "Image/XrayImage.h"
 #include "ImageViewWidget.h"
-#include "XrayImage.h"
 
 namespace fct {
 

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "DrrRendererFactory.h"
-#include "DrrVolume.h"
-#include "ImageFileWriter.h"
-#include "PoseFile.h"
-#include "ViewFile.h"
+#include "Drr/DrrRendererFactory.h"
+#include "Drr/DrrVolume.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Volume/CtLoader.h"
+#include "IO/Xray/ImageFileWriter.h"
 
 namespace fct::cli {
 

@@ -17,16 +17,16 @@
 #include <string>
 #include <vector>
 
+#include "Base/TextFile.h"
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "DrrRendererFactory.h"
-#include "PhantomBuilder.h"
-#include "RegistrationSchedule.h"
-#include "StudyCatalog.h"
-#include "StudyReport.h"
-#include "StudyRunner.h"
-#include "TextFile.h"
-#include "TrialStore.h"
+#include "Drr/DrrRendererFactory.h"
+#include "Evaluation/StudyCatalog.h"
+#include "Evaluation/StudyReport.h"
+#include "Evaluation/StudyRunner.h"
+#include "Evaluation/TrialStore.h"
+#include "IO/Volume/CtLoader.h"
+#include "Registration/RegistrationSchedule.h"
+#include "Simulation/PhantomBuilder.h"
 
 namespace fct::cli {
 

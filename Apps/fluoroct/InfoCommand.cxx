@@ -10,9 +10,9 @@
 #include <string>
 
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "XrayDicomReader.h"
-#include "XrayLoader.h"
+#include "IO/Dicom/XrayDicomReader.h"
+#include "IO/Volume/CtLoader.h"
+#include "IO/Xray/XrayLoader.h"
 
 namespace fct::cli {
 

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "CliSupport.h"
-#include "PhantomBuilder.h"
-#include "VolumeFileIO.h"
+#include "IO/Volume/VolumeFileIO.h"
+#include "Simulation/PhantomBuilder.h"
 
 namespace fct::cli {
 

@@ -6,11 +6,11 @@
 #include <memory>
 #include <string>
 
-#include "BoneSurface.h"
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "PoseFile.h"
-#include "PoseOffset.h"
+#include "Evaluation/PoseOffset.h"
+#include "Image/BoneSurface.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Volume/CtLoader.h"
 
 namespace fct::cli {
 

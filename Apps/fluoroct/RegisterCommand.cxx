@@ -13,19 +13,19 @@
 #include <string>
 #include <vector>
 
+#include "Base/JsonDocument.h"
+#include "Base/JsonReader.h"
 #include "CliSupport.h"
-#include "ContourOverlay.h"
-#include "CtLoader.h"
-#include "ImageFileWriter.h"
-#include "JsonDocument.h"
-#include "JsonReader.h"
-#include "LandmarkFile.h"
-#include "LandmarkPoseEstimator.h"
-#include "PoseFile.h"
-#include "Registration.h"
-#include "RegistrationStagesJson.h"
-#include "ViewFile.h"
-#include "XrayLoader.h"
+#include "Evaluation/ContourOverlay.h"
+#include "InitialPose/LandmarkPoseEstimator.h"
+#include "IO/Project/LandmarkFile.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Volume/CtLoader.h"
+#include "IO/Xray/ImageFileWriter.h"
+#include "IO/Xray/XrayLoader.h"
+#include "Registration/Registration.h"
+#include "Registration/RegistrationStagesJson.h"
 
 namespace fct::cli {
 
@@ -209,8 +209,8 @@ int runRegister(const Options& o) {
     auto image = readImage(spec);
     if (!image) return reportError(image.error());
     RegistrationView view{spec.name, std::move(image).value(), spec.camera, {}};
-    for (const CalibrationSphere& sphere : spec.calibrationSpheres) {
-      view.spheres.push_back(PixelCircle{sphere.center_px, sphere.radius_px});
+    for (const PixelCircle& sphere : spec.calibrationSpheres) {
+      view.spheres.push_back(PixelCircle{sphere.centre_px, sphere.radius_px});
     }
     views.push_back(std::move(view));
   }

@@ -12,15 +12,15 @@
 #include <string>
 #include <system_error>
 
+#include "Base/JsonDocument.h"
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "CtSliceDegrader.h"
-#include "DrrXraySimulator.h"
-#include "FluoroscopySimulator.h"
-#include "JsonDocument.h"
-#include "PoseFile.h"
-#include "ViewFile.h"
-#include "VolumeFileIO.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Volume/CtLoader.h"
+#include "IO/Volume/VolumeFileIO.h"
+#include "Simulation/CtSliceDegrader.h"
+#include "Simulation/DrrXraySimulator.h"
+#include "Simulation/FluoroscopySimulator.h"
 
 namespace fct::cli {
 

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "PoseErrorMetrics.h"
-#include "PoseFile.h"
+#include "Evaluation/PoseErrorMetrics.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Volume/CtLoader.h"
 
 namespace fct::cli {
 

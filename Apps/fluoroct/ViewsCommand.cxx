@@ -5,9 +5,9 @@
 #include <string>
 
 #include "CliSupport.h"
-#include "CtLoader.h"
-#include "StandardViews.h"
-#include "ViewFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Volume/CtLoader.h"
+#include "Simulation/StandardViews.h"
 
 namespace fct::cli {
 

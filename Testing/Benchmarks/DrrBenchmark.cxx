@@ -23,13 +23,13 @@
 #include <string>
 #include <vector>
 
-#include "Camera.h"
-#include "DicomSeriesReader.h"
-#include "DrrRendererFactory.h"
-#include "DrrVolume.h"
-#include "RigidPose.h"
-#include "TransgraphRenderer.h"
-#include "VolumeFileIO.h"
+#include "Drr/DrrRendererFactory.h"
+#include "Drr/DrrVolume.h"
+#include "Drr/TransgraphRenderer.h"
+#include "Geometry/Camera.h"
+#include "Geometry/RigidPose.h"
+#include "IO/Dicom/DicomSeriesReader.h"
+#include "IO/Volume/VolumeFileIO.h"
 
 namespace {
 
@@ -337,8 +337,9 @@ void benchmarkCt(const std::string& name, const fct::Volume& ctIn, const Options
             range.rotation_deg * Eigen::Vector3d(unit(random), unit(random), unit(random)),
             range.translation_mm * Eigen::Vector3d(unit(random), unit(random), unit(random))};
         const Eigen::Isometry3d p = fct::RigidPose::toTransform(delta, pose * ct.centre_lps_mm()) * pose;
-        (void)transgraph.render(view, p, 0, a);
-        fallbacks += transgraph.lastFallbackRayCount();
+        fct::DrrRenderStats stats;
+        (void)transgraph.render(view, p, 0, a, &stats);
+        fallbacks += stats.fallbackRays;
         (void)siddon->render(view, p, 0, b);
         nccs.push_back(ncc(a.pixels, b.pixels));
       }

@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "CtLoader.h"
-#include "PhantomBuilder.h"
-#include "Registration.h"
+#include "IO/Volume/CtLoader.h"
+#include "Registration/Registration.h"
 #include "RegistrationTestCase.h"
+#include "Simulation/PhantomBuilder.h"
 
 namespace {
 

@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "PoseFile.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Volume/VolumeFileIO.h"
+#include "IO/Xray/XrayImageFileReader.h"
 #include "TestSupport.h"
-#include "ViewFile.h"
-#include "VolumeFileIO.h"
-#include "XrayImageFileReader.h"
 
 namespace {
 

@@ -10,10 +10,10 @@
 #include <iterator>
 #include <string>
 
-#include "StudyCatalog.h"
+#include "Base/TextFile.h"
+#include "Evaluation/StudyCatalog.h"
+#include "Evaluation/TrialStore.h"
 #include "TestSupport.h"
-#include "TextFile.h"
-#include "TrialStore.h"
 
 namespace {
 

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
+#include "IO/Volume/VolumeFileIO.h"
 #include "TestSupport.h"
-#include "VolumeFileIO.h"
 
 TEST(PhantomCommand, WritesAReadableVolume) {
   const auto dir = fct::test::scratchDir();

@@ -1,11 +1,11 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
-#include "BoneSurface.h"
-#include "PhantomBuilder.h"
-#include "PoseFile.h"
+#include "Image/BoneSurface.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Volume/VolumeFileIO.h"
+#include "Simulation/PhantomBuilder.h"
 #include "TestSupport.h"
-#include "VolumeFileIO.h"
 
 TEST(PoseCommand, WritesARandomStartPoseAtTheRequestedSurfaceDistance) {
   const auto dir = fct::test::scratchDir();

@@ -7,11 +7,11 @@
 #include <fstream>
 #include <map>
 
-#include "JsonDocument.h"
-#include "LandmarkFile.h"
-#include "PoseFile.h"
+#include "Base/JsonDocument.h"
+#include "IO/Project/LandmarkFile.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
 #include "TestSupport.h"
-#include "ViewFile.h"
 
 namespace {
 

@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <fstream>
 
-#include "PoseFile.h"
+#include "Base/TextFile.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
+#include "IO/Xray/XrayImageFileReader.h"
 #include "TestSupport.h"
-#include "TextFile.h"
-#include "ViewFile.h"
-#include "XrayImageFileReader.h"
 
 namespace {
 

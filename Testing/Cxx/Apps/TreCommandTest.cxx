@@ -4,12 +4,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "JsonDocument.h"
-#include "PhantomBuilder.h"
-#include "PoseFile.h"
+#include "Base/JsonDocument.h"
+#include "Base/TextFile.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Volume/VolumeFileIO.h"
+#include "Simulation/PhantomBuilder.h"
 #include "TestSupport.h"
-#include "TextFile.h"
-#include "VolumeFileIO.h"
 
 namespace {
 

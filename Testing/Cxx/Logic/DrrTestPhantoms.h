@@ -9,9 +9,9 @@
 #include <functional>
 #include <memory>
 
-#include "Camera.h"
-#include "DrrVolume.h"
-#include "Volume.h"
+#include "Drr/DrrVolume.h"
+#include "Geometry/Camera.h"
+#include "Image/Volume.h"
 
 namespace fct::test {
 

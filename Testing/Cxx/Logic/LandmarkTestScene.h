@@ -5,9 +5,9 @@
 #include <map>
 #include <string>
 
-#include "Camera.h"
-#include "Landmarks.h"
-#include "RigidPose.h"
+#include "Geometry/Camera.h"
+#include "Geometry/Landmarks.h"
+#include "Geometry/RigidPose.h"
 
 namespace fct::test {
 

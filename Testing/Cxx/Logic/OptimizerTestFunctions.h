@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "PoseOptimizer.h"
+#include "Search/PoseOptimizer.h"
 
 namespace fct::test {
 

@@ -14,16 +14,16 @@
 #include <string>
 #include <vector>
 
-#include "BoneSurface.h"
-#include "PoseOffset.h"
-#include "DrrRendererFactory.h"
-#include "DrrXraySimulator.h"
-#include "PoseOptimizer.h"
-#include "RegistrationCase.h"
-#include "Result.h"
-#include "RigidPose.h"
-#include "StandardViews.h"
-#include "Volume.h"
+#include "Base/Result.h"
+#include "Drr/DrrRendererFactory.h"
+#include "Evaluation/PoseOffset.h"
+#include "Geometry/RigidPose.h"
+#include "Image/BoneSurface.h"
+#include "Image/Volume.h"
+#include "Registration/RegistrationCase.h"
+#include "Search/PoseOptimizer.h"
+#include "Simulation/DrrXraySimulator.h"
+#include "Simulation/StandardViews.h"
 
 namespace fct::test {
 

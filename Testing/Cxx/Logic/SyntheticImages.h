@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "FloatImage.h"
+#include "Image/FloatImage.h"
 
 namespace fct::test {
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <optional>
 
-#include "XrayImage.h"
+#include "Image/XrayImage.h"
 
 namespace fct::test {
 

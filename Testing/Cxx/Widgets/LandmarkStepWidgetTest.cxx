@@ -5,7 +5,7 @@
 
 #include <QTableWidget>
 
-#include "LandmarkFile.h"
+#include "IO/Project/LandmarkFile.h"
 #include "LandmarkStepWidget.h"
 #include "StepTestSession.h"
 #include "TestSupport.h"

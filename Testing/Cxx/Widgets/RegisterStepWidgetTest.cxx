@@ -3,7 +3,7 @@
 // missing initial pose is refused with a message.
 #include <gtest/gtest.h>
 
-#include "PoseOffset.h"
+#include "Evaluation/PoseOffset.h"
 #include "RegisterStepWidget.h"
 #include "StepTestSession.h"
 

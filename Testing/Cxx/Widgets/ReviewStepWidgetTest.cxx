@@ -4,9 +4,9 @@
 
 #include <QImage>
 
-#include "ItkTransformFile.h"
-#include "PoseFile.h"
-#include "PoseOffset.h"
+#include "Evaluation/PoseOffset.h"
+#include "IO/Project/ItkTransformFile.h"
+#include "IO/Project/PoseFile.h"
 #include "ReviewStepWidget.h"
 #include "StepTestSession.h"
 #include "TestSupport.h"

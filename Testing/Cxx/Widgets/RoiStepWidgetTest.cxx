@@ -7,8 +7,8 @@
 
 #include <cmath>
 
-#include "DynamicRoiSelector.h"
 #include "RoiStepWidget.h"
+#include "Similarity/DynamicRoiSelector.h"
 #include "StepTestSession.h"
 
 TEST(RoiStepWidget, RaisingTheThresholdSliderKeepsFewerPixelsInEveryView) {

@@ -17,9 +17,9 @@
 #include <memory>
 #include <vector>
 
-#include "BoneSurface.h"
+#include "Image/BoneSurface.h"
 #include "Logic/RegistrationTestCase.h"
-#include "PhantomBuilder.h"
+#include "Simulation/PhantomBuilder.h"
 #include "SliceViewWidget.h"
 #include "StudioDocument.h"
 #include "XrayViewWidget.h"

@@ -7,14 +7,14 @@
 #include <QRadioButton>
 #include <QSlider>
 
-#include "ItkTransformFile.h"
+#include "IO/Project/ItkTransformFile.h"
+#include "IO/Volume/VolumeFileIO.h"
 #include "LandmarkStepWidget.h"
 #include "RegisterStepWidget.h"
 #include "ReviewStepWidget.h"
 #include "RoiStepWidget.h"
 #include "StepTestSession.h"
 #include "TestSupport.h"
-#include "VolumeFileIO.h"
 
 namespace {
 

@@ -1,0 +1,23 @@
+#pragma once
+// TextHeader: small parsing helpers for the text headers of NRRD and MetaImage files.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "Base/Result.h"
+
+namespace fct {
+
+/// Helpers for "key: value" / "key = value" text headers.
+class TextHeader {
+ public:
+  /// The text without leading and trailing white space.
+  static std::string trim(std::string_view text);
+  /// The text in lower case (ASCII).
+  static std::string lower(std::string_view text);
+  /// Exactly `count` finite numbers separated by spaces, commas or parentheses; fails naming `field` otherwise.
+  static Result<std::vector<double>> numbers(std::string_view text, std::size_t count, std::string_view field);
+};
+
+}  // namespace fct

@@ -1,0 +1,123 @@
+#include "Drr/DrrVolume.h"
+
+#include <fmt/core.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace fct {
+
+Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& options) {
+  if (ct.voxelCount() == 0) return fail("the CT volume is empty; load a CT before rendering DRRs");
+  if (options.kind == DrrValueKind::Attenuation &&
+      (!std::isfinite(options.waterAttenuation_per_mm) || options.waterAttenuation_per_mm <= 0.0)) {
+    return fail(fmt::format("water attenuation must be positive and finite, got {} /mm", options.waterAttenuation_per_mm));
+  }
+  DrrVolume volume;
+  volume.m_values = ct;
+  volume.m_options = options;
+  volume.m_T_ct_from_ijk = ct.T_lps_from_ijk();
+  volume.m_T_ijk_from_ct = ct.T_ijk_from_lps();
+
+  std::vector<float>& voxels = volume.m_values.voxels();
+  const float mu_water = static_cast<float>(options.waterAttenuation_per_mm);
+  const bool attenuation = options.kind == DrrValueKind::Attenuation;
+  const std::size_t nonFinite = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, voxels.size(), 1 << 16), std::size_t{0},
+      [&](const tbb::blocked_range<std::size_t>& range, std::size_t count) {
+        for (std::size_t n = range.begin(); n != range.end(); ++n) {
+          const float value = voxels[n];
+          if (!std::isfinite(value)) {
+            ++count;
+            voxels[n] = 0.0f;
+          } else if (attenuation) {
+            voxels[n] = value <= -1000.0f ? 0.0f : mu_water * (1.0f + value * 0.001f);
+          }
+        }
+        return count;
+      },
+      std::plus<>());
+  if (nonFinite > 0) {
+    return fail(fmt::format("the CT has {} voxels that are NaN or infinite; repair or re-export the volume", nonFinite));
+  }
+  volume.findContentBox();
+  return volume;
+}
+
+Result<DrrVolume> DrrVolume::coarsened(const Eigen::Vector3i& blockSize_ijk) const {
+  if ((blockSize_ijk.array() < 1).any()) {
+    return fail(fmt::format("CT block size must be at least 1 voxel per axis, got {}x{}x{}", blockSize_ijk.x(),
+                            blockSize_ijk.y(), blockSize_ijk.z()));
+  }
+  const Eigen::Vector3i& fine = dims();
+  const Eigen::Vector3i coarse = (fine + blockSize_ijk - Eigen::Vector3i::Ones()).cwiseQuotient(blockSize_ijk);
+  // The first coarse voxel's centre is the centre of its block's voxels.
+  const Eigen::Vector3d firstCentre_ijk = 0.5 * (blockSize_ijk - Eigen::Vector3i::Ones()).cast<double>();
+  auto grid = Volume::create(coarse, m_values.spacing_mm().cwiseProduct(blockSize_ijk.cast<double>()),
+                             m_values.lpsFromIjk(firstCentre_ijk), m_values.direction_lps());
+  if (!grid) return fail("coarse CT: " + grid.error());
+  DrrVolume volume;
+  volume.m_values = std::move(grid).value();
+  volume.m_options = m_options;
+  volume.m_T_ct_from_ijk = volume.m_values.T_lps_from_ijk();
+  volume.m_T_ijk_from_ct = volume.m_values.T_ijk_from_lps();
+  const float weight = 1.0f / static_cast<float>(blockSize_ijk.prod());
+  tbb::parallel_for(0, coarse.z(), [&](int K) {
+    for (int k = K * blockSize_ijk.z(); k < std::min(fine.z(), (K + 1) * blockSize_ijk.z()); ++k) {
+      for (int j = 0; j < fine.y(); ++j) {
+        const float* row = data() + m_values.offset(0, j, k);
+        float* coarseRow = &volume.m_values.at(0, j / blockSize_ijk.y(), K);
+        for (int i = 0; i < fine.x(); ++i) coarseRow[i / blockSize_ijk.x()] += weight * row[i];
+      }
+    }
+  });
+  volume.findContentBox();
+  return volume;
+}
+
+void DrrVolume::findContentBox() {
+  const Eigen::Vector3i n = dims();
+  const std::vector<float>& voxels = m_values.voxels();
+  struct Box {
+    Eigen::Vector3i first = Eigen::Vector3i::Constant(std::numeric_limits<int>::max());
+    Eigen::Vector3i last = Eigen::Vector3i::Constant(-1);
+    Box merged(const Box& other) const { return {first.cwiseMin(other.first), last.cwiseMax(other.last)}; }
+  };
+  const Box box = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, n.z()), Box{},
+      [&](const tbb::blocked_range<int>& slices, Box box) {
+        for (int k = slices.begin(); k != slices.end(); ++k) {
+          for (int j = 0; j < n.y(); ++j) {
+            const float* row = voxels.data() + m_values.offset(0, j, k);
+            int i = 0;
+            while (i < n.x() && row[i] == 0.0f) ++i;
+            if (i == n.x()) continue;
+            int last = n.x() - 1;
+            while (row[last] == 0.0f) --last;
+            box.first = box.first.cwiseMin(Eigen::Vector3i(i, j, k));
+            box.last = box.last.cwiseMax(Eigen::Vector3i(last, j, k));
+          }
+        }
+        return box;
+      },
+      [](const Box& a, const Box& b) { return a.merged(b); });
+  m_contentFirst_ijk = box.last.x() < 0 ? Eigen::Vector3i::Zero() : box.first;
+  m_contentLast_ijk = box.last;
+}
+
+Result<DrrValueKind> DrrVolume::parseValueKind(std::string_view name) {
+  if (name == "attenuation") return DrrValueKind::Attenuation;
+  if (name == "raw") return DrrValueKind::Raw;
+  return fail(fmt::format("unknown DRR values '{}'; use 'attenuation' or 'raw'", name));
+}
+
+std::string_view DrrVolume::valueKindName(DrrValueKind kind) {
+  return kind == DrrValueKind::Raw ? "raw" : "attenuation";
+}
+
+}  // namespace fct

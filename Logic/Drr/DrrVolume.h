@@ -1,0 +1,89 @@
+#pragma once
+// DrrVolume: the CT prepared once for DRR rendering: per-voxel values whose line integral is the DRR
+// (attenuation µ in 1/mm, or the raw voxel value), on the CT's voxel grid, with the CT index <-> CT mm maps.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string_view>
+
+#include "Base/Result.h"
+#include "Image/Volume.h"
+
+namespace fct {
+
+/// What a DRR integrates along each ray.
+enum class DrrValueKind {
+  /// µ = µ_water · (1 + HU / 1000) in 1/mm, HU <= -1000 (air and below) clamped to 0; the DRR ∫µ dl is dimensionless.
+  Attenuation,
+  /// The voxel value as stored (HU for a CT, negative in air); the DRR ∫value dl is in value·mm.
+  Raw,
+};
+
+/// How voxel values become DRR values.
+struct DrrValueOptions {
+  /// Linear attenuation coefficient of water at 60 keV, the effective energy of a ~100-120 kVp fluoroscopy beam:
+  /// µ/ρ = 0.2059 cm²/g (NIST XCOM / Hubbell & Seltzer, NIST Standard Reference Database 126, liquid water), ρ = 1 g/cm³.
+  static constexpr double kWaterAttenuationAt60keV_per_mm = 0.02059;
+
+  DrrValueKind kind = DrrValueKind::Attenuation;
+  double waterAttenuation_per_mm = kWaterAttenuationAt60keV_per_mm;  ///< µ_water used by Attenuation
+};
+
+/// The per-voxel DRR values of a CT (float, i fastest) and its geometry. Voxel (i,j,k) is the box of one spacing
+/// around its centre, so the volume's extent in index space is [-0.5, dims - 0.5] per axis.
+class DrrVolume {
+ public:
+  DrrVolume() = default;
+
+  /// Converts a CT once. Fails on an empty volume, non-finite voxels, or a non-positive or non-finite µ_water.
+  static Result<DrrVolume> create(const Volume& ct, const DrrValueOptions& options = {});
+
+  /// The values box-averaged over blocks of blockSize_ijk voxels (each >= 1): coarse voxel (I,J,K) is the mean of
+  /// voxels [I·b, I·b + b - 1] per axis, where voxels beyond the volume count as 0 (air for attenuation values), so
+  /// the coarse grid covers the volume rounded up to whole blocks. Same options and frame; spacing times the block.
+  /// A line integral through the result equals one through the original CT blurred by the block (less traversal
+  /// work: the coarse pyramid levels of registration use it). Fails on a block size below 1.
+  Result<DrrVolume> coarsened(const Eigen::Vector3i& blockSize_ijk) const;
+
+  /// Parses "attenuation" or "raw"; the error lists the accepted names.
+  static Result<DrrValueKind> parseValueKind(std::string_view name);
+  /// The name parseValueKind() accepts for `kind`.
+  static std::string_view valueKindName(DrrValueKind kind);
+
+  /// The DRR values on the CT grid: 1/mm for Attenuation, the CT's unit for Raw. Geometry equals the CT's.
+  const Volume& values() const { return m_values; }
+  /// Which values were computed and with which µ_water.
+  const DrrValueOptions& options() const { return m_options; }
+  /// Voxel count along i, j, k.
+  const Eigen::Vector3i& dims() const { return m_values.dims(); }
+  /// Contiguous voxel values, i fastest, then j, then k.
+  const float* data() const { return m_values.voxels().data(); }
+  /// Map from CT physical mm (LPS) to continuous voxel index.
+  const Eigen::Affine3d& T_ijk_from_ct() const { return m_T_ijk_from_ct; }
+  /// Map from continuous voxel index to CT physical mm (LPS).
+  const Eigen::Affine3d& T_ct_from_ijk() const { return m_T_ct_from_ijk; }
+  /// Lower corner of the voxel boxes in index space: (-0.5, -0.5, -0.5).
+  Eigen::Vector3d boxMin_ijk() const { return Eigen::Vector3d::Constant(-0.5); }
+  /// Upper corner of the voxel boxes in index space: dims - 0.5.
+  Eigen::Vector3d boxMax_ijk() const { return dims().cast<double>().array() - 0.5; }
+  /// True when at least one value is non-zero (otherwise every DRR is zero).
+  bool hasContent() const { return (m_contentFirst_ijk.array() <= m_contentLast_ijk.array()).all(); }
+  /// Lower corner, in index space, of the smallest box of whole voxels holding every non-zero value (air is 0 in
+  /// attenuation values, so this is usually the patient, not the scan field); only meaningful when hasContent().
+  Eigen::Vector3d contentBoxMin_ijk() const { return m_contentFirst_ijk.cast<double>().array() - 0.5; }
+  /// Upper corner of that box in index space.
+  Eigen::Vector3d contentBoxMax_ijk() const { return m_contentLast_ijk.cast<double>().array() + 0.5; }
+
+ private:
+  /// Sets the content box from the values.
+  void findContentBox();
+
+  Volume m_values;
+  DrrValueOptions m_options;
+  Eigen::Affine3d m_T_ijk_from_ct = Eigen::Affine3d::Identity();
+  Eigen::Affine3d m_T_ct_from_ijk = Eigen::Affine3d::Identity();
+  Eigen::Vector3i m_contentFirst_ijk = Eigen::Vector3i::Zero();       ///< first voxel index of the content box
+  Eigen::Vector3i m_contentLast_ijk = Eigen::Vector3i::Constant(-1);  ///< last voxel index (first > last: none)
+};
+
+}  // namespace fct

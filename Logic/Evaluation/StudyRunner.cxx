@@ -1,0 +1,316 @@
+#include "Evaluation/StudyRunner.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <thread>
+
+#include "Base/SeededRandom.h"
+#include "Drr/DrrRendererFactory.h"
+#include "Evaluation/PoseErrorMetrics.h"
+#include "Evaluation/PoseOffset.h"
+#include "Evaluation/StudyXraySource.h"
+#include "Geometry/RigidPose.h"
+#include "Registration/Registration.h"
+#include "Registration/RegistrationCase.h"
+#include "Simulation/StandardViews.h"
+
+namespace fct {
+
+namespace {
+
+constexpr int kMaxJobs = 64;
+constexpr int kMaxViews = 5;
+
+/// Everything about one CT that its trials share: error measures, truth and the simulated X-rays (all views).
+struct CtScene {
+  const Volume* ct = nullptr;
+  std::unique_ptr<PoseErrorMetrics> metrics;
+  Eigen::Isometry3d T_truth = Eigen::Isometry3d::Identity();
+  std::vector<RegistrationView> xrays;
+};
+
+/// One trial to run.
+struct PendingTrial {
+  const StudyCondition* condition = nullptr;
+  int trial = 0;
+};
+
+/// Conditions registering on the same CT (after resampling, if any) with the same views share a case.
+std::string caseKey(const StudyCondition& c, const Volume& ct) {
+  return fmt::format("{}|{}|{}", c.ct, StudyXraySource::effectiveSliceSpacing_mm(ct, c.sliceSpacing_mm), c.viewCount);
+}
+
+Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, const StudyRunOptions& options) {
+  if (options.jobs < 1 || options.jobs > kMaxJobs) {
+    return fail(fmt::format("--jobs must be between 1 and {}, got {}", kMaxJobs, options.jobs));
+  }
+  if (study.conditions.empty()) return fail(fmt::format("study '{}' has no condition", study.name));
+  std::set<std::string> names;
+  for (const StudyCondition& c : study.conditions) {
+    if (!names.insert(c.name).second) return fail(fmt::format("study '{}': condition '{}' appears twice", study.name, c.name));
+    const bool known = std::any_of(cts.begin(), cts.end(), [&](const StudyCt& ct) { return ct.label == c.ct; });
+    if (!known) return fail(fmt::format("study '{}', condition '{}': no CT labelled '{}' was given", study.name, c.name, c.ct));
+    if (c.viewCount < 1 || c.viewCount > kMaxViews) {
+      return fail(fmt::format("condition '{}': {} views; use 1 to {}", c.name, c.viewCount, kMaxViews));
+    }
+    if (c.trials < 1) return fail(fmt::format("condition '{}': {} trials; use at least 1", c.name, c.trials));
+    if (!(c.initialLow_mm >= 0.0) || !(c.initialHigh_mm >= c.initialLow_mm) || !std::isfinite(c.initialHigh_mm)) {
+      return fail(fmt::format("condition '{}': initial sTRE range {}..{} mm is not a finite range from 0 up", c.name,
+                              c.initialLow_mm, c.initialHigh_mm));
+    }
+  }
+  return Ok{};
+}
+
+/// The record of a trial that did not register: identification, NaN errors, status "failed" and the reason.
+TrialRecord failedTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const std::string& reason) {
+  TrialRecord r;
+  r.study = study.name;
+  r.ct = c.ct;
+  r.condition = c.name;
+  r.scenario = c.scenario;
+  r.variant = c.variant;
+  r.views = c.viewCount;
+  r.trial = trial;
+  r.seed = study.setup.seed + static_cast<std::uint32_t>(trial);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  r.error = PoseError{nan, nan, nan, nan, nan};
+  r.status = "failed";
+  r.reason = reason;
+  return r;
+}
+
+/// Runs one trial on `registrationCase` (a worker's own copy).
+TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const CtScene& scene,
+                     RegistrationCase& registrationCase, const RegistrationSchedule& schedule,
+                     const std::atomic<bool>* cancel) {
+  TrialRecord r = failedTrial(study, c, trial, "");
+
+  SeededRandom random(r.seed ^ 0x5BD1E995u);
+  r.initialTarget_mm = c.initialLow_mm + (c.initialHigh_mm - c.initialLow_mm) * random.uniform01();
+  auto start = PoseOffset::randomAtSurfaceDistance(scene.metrics->surface(), scene.T_truth, r.initialTarget_mm, r.seed);
+  if (!start) {
+    r.reason = "start pose: " + start.error();
+    return r;
+  }
+  r.initialStre_mm = scene.metrics->measure(start.value(), scene.T_truth).streMean_mm;
+
+  RegistrationOptions options;
+  options.schedule = schedule;
+  options.ablation = c.ablation;
+  options.seed = r.seed;
+  const auto clockStart = std::chrono::steady_clock::now();
+  auto result = Registration::run(registrationCase, start.value(), options, {}, cancel);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clockStart).count();
+  if (!result) {
+    r.reason = result.error();
+    return r;
+  }
+  r.setupSeconds = result.value().viewRendererSetupSeconds;
+  r.seconds -= r.setupSeconds;
+  r.status = "ok";
+  r.drrs = result.value().totalDrrs;
+  r.error = scene.metrics->measure(result.value().T_world_from_ct, scene.T_truth);
+  r.success = PoseErrorMetrics::isSuccess(r.error);
+  if (result.value().cancelled) {
+    r.status = "cancelled";
+    r.reason = "cancelled before the registration ended";
+  }
+  return r;
+}
+
+}  // namespace
+
+Eigen::Isometry3d StudyRunner::truthPose(const BoneSurface& bone) {
+  const Eigen::Vector3d centre_ct_mm = bone.centroid_ct_mm();
+  PoseParameters truth;
+  truth.rotation_deg = Eigen::Vector3d(4.0, -3.0, 6.0);
+  truth.translation_mm = -centre_ct_mm + Eigen::Vector3d(2.0, -3.0, 1.5);
+  return RigidPose::toTransform(truth, centre_ct_mm);
+}
+
+void StudyRunner::resolveSliceSpacings(StudyDefinition& study, const std::vector<StudyCt>& cts) {
+  for (StudyCondition& c : study.conditions) {
+    const auto ct = std::find_if(cts.begin(), cts.end(), [&](const StudyCt& s) { return s.label == c.ct; });
+    if (ct == cts.end()) continue;
+    const double resampled_mm = StudyXraySource::effectiveSliceSpacing_mm(ct->volume, c.sliceSpacing_mm);
+    c.usedSliceSpacing_mm = resampled_mm > 0.0 ? resampled_mm : ct->volume.spacing_mm().z();
+  }
+}
+
+std::vector<std::string> StudyRunner::notes(const StudyDefinition& study, const std::vector<StudyCt>& cts) {
+  std::vector<std::string> out{"X-rays: " + StudyXraySource::description()};
+  if (study.setup.method == DrrMethod::Transgraph) {
+    out.push_back(fmt::format("DRRs: transgraph method, tables at a {:g} mm step built around each trial's start pose "
+                              "(not the truth) and cached in {}; the 'setup s' column is their build or load time, "
+                              "not part of the registration time",
+                              study.setup.transgraphSpacing_mm,
+                              study.setup.transgraphCacheDir.empty() ? std::string("no cache")
+                                                                     : study.setup.transgraphCacheDir.string()));
+  } else {
+    out.push_back(fmt::format("DRRs: {} method", DrrRendererFactory::methodName(study.setup.method)));
+  }
+  std::set<std::string> said;
+  for (const StudyCondition& c : study.conditions) {
+    const auto ct = std::find_if(cts.begin(), cts.end(), [&](const StudyCt& s) { return s.label == c.ct; });
+    if (ct == cts.end() || c.sliceSpacing_mm <= 0.0 ||
+        StudyXraySource::effectiveSliceSpacing_mm(ct->volume, c.sliceSpacing_mm) > 0.0) {
+      continue;
+    }
+    const std::string key = fmt::format("{}|{}", c.ct, c.sliceSpacing_mm);
+    if (!said.insert(key).second) continue;
+    out.push_back(fmt::format("CT '{}' has {:g} mm slices already, so scenario '{}' ({:g} mm) registers on the original "
+                              "CT",
+                              c.ct, ct->volume.spacing_mm().z(), c.scenario, c.sliceSpacing_mm));
+  }
+  return out;
+}
+
+RegistrationSchedule StudyRunner::scheduleFor(const RegistrationSchedule& base, StudyMeasures measures) {
+  RegistrationSchedule schedule = base;
+  if (measures == StudyMeasures::Both) return schedule;
+  const SimilarityMetric metric = measures == StudyMeasures::NccOnly ? SimilarityMetric::Ncc : SimilarityMetric::Vlnc;
+  for (RegistrationStage& stage : schedule.stages) stage.metric = metric;
+  schedule.name += measures == StudyMeasures::NccOnly ? " (ncc only)" : " (vlnc only)";
+  return schedule;
+}
+
+Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std::vector<StudyCt>& cts,
+                                         TrialStore& store, const StudyRunOptions& options) {
+  if (Status valid = validate(study, cts, options); !valid) return fail(valid.error());
+  auto baseSchedule = RegistrationSchedule::resolve(study.setup.preset);
+  if (!baseSchedule) return fail(baseSchedule.error());
+  const auto message = [&](const std::string& text) {
+    if (options.onMessage) options.onMessage(text);
+  };
+
+  StudyRunSummary summary;
+  std::vector<PendingTrial> pending;
+  for (const StudyCondition& c : study.conditions) {
+    for (int t = 0; t < c.trials; ++t) {
+      if (store.isDone(study.name, c.name, t)) {
+        ++summary.skipped;
+      } else {
+        pending.push_back(PendingTrial{&c, t});
+      }
+    }
+  }
+  if (summary.skipped > 0) message(fmt::format("{} trials already in {}; skipping them", summary.skipped, store.path().string()));
+  if (pending.empty()) return summary;
+
+  // Per CT: measures, truth and X-rays for as many views as any pending trial needs.
+  std::map<std::string, CtScene> scenes;
+  for (const StudyCt& ct : cts) {
+    int viewCount = 0;
+    for (const PendingTrial& p : pending) {
+      if (p.condition->ct == ct.label) viewCount = std::max(viewCount, p.condition->viewCount);
+    }
+    if (viewCount == 0) continue;
+    CtScene scene;
+    scene.ct = &ct.volume;
+    auto metrics = PoseErrorMetrics::create(ct.volume);
+    if (!metrics) return fail(fmt::format("CT '{}': {}", ct.label, metrics.error()));
+    scene.metrics = std::make_unique<PoseErrorMetrics>(std::move(metrics).value());
+    scene.T_truth = truthPose(scene.metrics->surface());
+    StandardViewOptions viewOptions = study.setup.detector;
+    viewOptions.count = viewCount;
+    auto views = StandardViews::build(Eigen::Vector3d::Zero(), viewOptions);
+    if (!views) return fail(views.error());
+    message(fmt::format("simulating {} X-ray views of CT '{}'", viewCount, ct.label));
+    auto xrays = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, study.setup.seed);
+    if (!xrays) return fail(fmt::format("CT '{}': {}", ct.label, xrays.error()));
+    scene.xrays = std::move(xrays).value();
+    scenes.emplace(ct.label, std::move(scene));
+  }
+
+  // Per (CT, slice spacing, view count): one prepared registration case, copied by each worker (transgraph method: by
+  // each trial, whose tables are then built around its own start pose by Registration::run).
+  RegistrationCaseOptions caseOptions;
+  caseOptions.drr.method = study.setup.method;
+  caseOptions.drr.transgraph.spacing_mm = study.setup.transgraphSpacing_mm;
+  caseOptions.drr.transgraphCacheFolder = study.setup.transgraphCacheDir.empty()
+                                              ? std::nullopt
+                                              : std::optional<std::filesystem::path>(study.setup.transgraphCacheDir);
+  const bool tablePerTrial = study.setup.method == DrrMethod::Transgraph;
+  std::map<std::string, std::unique_ptr<RegistrationCase>> prototypes;
+  for (const PendingTrial& p : pending) {
+    const StudyCondition& c = *p.condition;
+    const CtScene& scene = scenes.at(c.ct);
+    const std::string key = caseKey(c, *scene.ct);
+    if (prototypes.count(key)) continue;
+    const double sliceSpacing_mm = StudyXraySource::effectiveSliceSpacing_mm(*scene.ct, c.sliceSpacing_mm);
+    message(fmt::format("preparing registration on CT '{}' ({}) with {} views", c.ct,
+                        sliceSpacing_mm > 0 ? fmt::format("{:g} mm slices", sliceSpacing_mm) : "original slices",
+                        c.viewCount));
+    auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
+    if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
+    const std::vector<RegistrationView> views(scene.xrays.begin(), scene.xrays.begin() + c.viewCount);
+    auto created = RegistrationCase::create(registrationCt.value(), views, caseOptions);
+    if (!created) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, created.error()));
+    prototypes.emplace(key, std::make_unique<RegistrationCase>(std::move(created).value()));
+  }
+
+  std::map<StudyMeasures, RegistrationSchedule> schedules;
+  for (StudyMeasures m : {StudyMeasures::Both, StudyMeasures::NccOnly, StudyMeasures::VlncOnly}) {
+    schedules.emplace(m, scheduleFor(baseSchedule.value(), m));
+  }
+
+  std::mutex mutex;
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> storeFailed{false};
+  std::string storeError;
+  int finished = 0;
+  const auto cancelled = [&] { return options.cancel && options.cancel->load(); };
+  const auto worker = [&] {
+    std::map<std::string, RegistrationCase> ownCases;
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= pending.size() || storeFailed.load() || cancelled()) return;
+      const StudyCondition& c = *pending[i].condition;
+      const std::string key = caseKey(c, *scenes.at(c.ct).ct);
+      auto found = ownCases.find(key);
+      if (found == ownCases.end()) {
+        found = ownCases.emplace(key, *prototypes.at(key)).first;
+      } else if (tablePerTrial) {
+        found->second = *prototypes.at(key);  // no tables yet: this trial builds (or loads) them around its start
+      }
+      TrialRecord record;
+      try {
+        record = runTrial(study, c, pending[i].trial, scenes.at(c.ct), found->second, schedules.at(c.measures),
+                          options.cancel);
+      } catch (const std::exception& e) {  // e.g. out of memory: this trial fails, the study goes on
+        record = failedTrial(study, c, pending[i].trial, fmt::format("unexpected error: {}", e.what()));
+      }
+      const std::lock_guard lock(mutex);
+      ++summary.ran;
+      if (record.status == "failed") ++summary.failed;
+      if (record.status == "cancelled") summary.cancelled = true;
+      if (Status saved = store.add(record); !saved && !storeFailed.exchange(true)) storeError = saved.error();
+      ++finished;
+      if (options.onTrial) options.onTrial(StudyProgress{finished, static_cast<int>(pending.size()), record});
+    }
+  };
+  const int threads = std::min<int>(options.jobs, static_cast<int>(pending.size()));
+  if (threads == 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (std::thread& thread : pool) thread.join();
+  }
+  if (storeFailed) return fail("cannot save the trials: " + storeError);
+  summary.cancelled = summary.cancelled || cancelled();
+  return summary;
+}
+
+}  // namespace fct

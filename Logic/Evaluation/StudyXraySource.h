@@ -1,0 +1,37 @@
+#pragma once
+// StudyXraySource: where a study's test X-rays and registration CTs come from (one seam, so the simulator can be
+// swapped without touching the studies). X-rays are always rendered from the ORIGINAL CT at the true pose; the
+// registration CT of the "realistic" and "bad" scenarios is the original resampled to a coarser slice spacing.
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "Base/Result.h"
+#include "Image/Volume.h"
+#include "IO/Project/ViewFile.h"
+#include "Registration/RegistrationView.h"
+
+namespace fct {
+
+/// Makes the images and CTs of study trials.
+class StudyXraySource {
+ public:
+  /// One line naming the forward model in use, for reports.
+  static std::string description();
+  /// Simulated X-rays of `ct` (LPS mm) at T_world_from_ct for every view (detector sizes from the cameras), view n
+  /// with noise seed `seed + n`. Fails, naming the view, on a rendering or simulation error.
+  static Result<std::vector<RegistrationView>> simulate(const Volume& ct, const std::vector<ViewSpec>& views,
+                                                        const Eigen::Isometry3d& T_world_from_ct, std::uint32_t seed);
+  /// The CT registration sees: `ct` resampled to `sliceSpacing_mm` along its slice axis with the matching
+  /// slice-thickness blur (CtSliceDegrader), or `ct` itself when effectiveSliceSpacing_mm() is 0. Fails on a negative
+  /// or non-finite spacing or a resampling error.
+  static Result<Volume> registrationCt(const Volume& ct, double sliceSpacing_mm);
+  /// The slice spacing registrationCt() resamples to: `sliceSpacing_mm` if it is above the CT's own slice spacing,
+  /// else 0 (the original CT is used: its slices are already that coarse, or 0 was asked).
+  static double effectiveSliceSpacing_mm(const Volume& ct, double sliceSpacing_mm);
+};
+
+}  // namespace fct

@@ -1,0 +1,210 @@
+#include "Registration/RegistrationCase.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "Geometry/RigidPose.h"
+#include "Search/PoseOptimizer.h"
+
+namespace fct {
+
+namespace {
+
+/// The options of the exact renderer: the method's own, or Siddon under the per-view Transgraphs.
+DrrRendererOptions exactRendererOptions(DrrRendererOptions options) {
+  if (options.method == DrrMethod::Transgraph) options.method = DrrMethod::Siddon;
+  return options;
+}
+
+}  // namespace
+
+Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::vector<RegistrationView>& views,
+                                                  const RegistrationCaseOptions& options,
+                                                  const ProgressMonitor& monitor) {
+  if (views.empty()) return fail("registration needs at least one X-ray view; the view list is empty");
+  RegistrationCase result;
+
+  auto drrVolume = DrrVolume::create(ct);
+  if (!drrVolume) return fail("CT: " + drrVolume.error());
+  result.m_drrVolume = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
+  result.m_drrOptions = options.drr;
+  auto renderer = DrrRendererFactory::create(result.m_drrVolume, exactRendererOptions(options.drr));
+  if (!renderer) return fail(renderer.error());
+  result.m_renderer = std::move(renderer).value();
+  result.m_viewRenderersReady = options.drr.method != DrrMethod::Transgraph;
+
+  for (const RegistrationView& view : views) {
+    const CameraIntrinsics& in = view.camera.intrinsics();
+    if (in.cols != view.xray.cols || in.rows != view.xray.rows) {
+      return fail(fmt::format("view '{}': the camera's detector is {}x{} pixels but the X-ray is {}x{}; fix the view "
+                              "file's detector size",
+                              view.name, in.cols, in.rows, view.xray.cols, view.xray.rows));
+    }
+    XrayImage xray = view.xray;
+    xray.camera = view.camera;
+    XrayPreparationOptions preparation = options.preparation;
+    preparation.spheres.insert(preparation.spheres.end(), view.spheres.begin(), view.spheres.end());
+    auto prepared = XrayPreparation(preparation).prepare(xray);
+    if (!prepared) return fail(fmt::format("view '{}': {}", view.name, prepared.error()));
+
+    // A constant X-ray (over its valid pixels) carries no information to register against.
+    const PyramidLevel& level0 = prepared.value().pyramid.level(0);
+    float lo = std::numeric_limits<float>::infinity();
+    float hi = -lo;
+    for (std::size_t i = 0; i < level0.image.pixels.size(); ++i) {
+      if (!level0.mask.valid[i]) continue;
+      lo = std::min(lo, level0.image.pixels[i]);
+      hi = std::max(hi, level0.image.pixels[i]);
+    }
+    if (!(hi > lo)) {
+      return fail(fmt::format("view '{}': the X-ray is constant ({}) over its {} valid pixels; there is nothing to "
+                              "register against (check the image file)",
+                              view.name, lo, level0.mask.validCount()));
+    }
+    result.m_views.push_back(View{view.name, view.camera, std::move(prepared).value(), {}, result.m_renderer, nullptr});
+  }
+
+  auto bone = BoneSurface::extract(ct, options.boneThreshold_hu);
+  if (bone) {
+    result.m_centre_ct_mm = bone.value().centroid_ct_mm();
+    result.m_boneRadius_mm = bone.value().radius_mm();
+    result.m_bone = std::move(bone).value();
+  } else {
+    const Eigen::Vector3d extent_mm = ct.dims().cast<double>().cwiseProduct(ct.spacing_mm());
+    result.m_centre_ct_mm = ct.centre_lps_mm();
+    result.m_boneRadius_mm = 0.25 * extent_mm.norm();
+  }
+  auto scales = PoseOptimizer::scalesForBoneRadius(result.m_boneRadius_mm);
+  if (!scales) return fail("bone radius: " + scales.error());
+  result.m_scales = scales.value();
+  std::vector<std::string> warnings;
+  if (options.T_expected_world_from_ct) {
+    const Status tables = result.prepareViewRenderers(*options.T_expected_world_from_ct, monitor);
+    if (!tables) return fail(tables.error());
+    warnings = tables.warnings();
+  }
+  Result<RegistrationCase> out(std::move(result));
+  for (std::string& warning : warnings) out.addWarning(std::move(warning));
+  if (!bone) {
+    out.addWarning(fmt::format("no bone surface at {} HU ({}); rotating about the volume centre", options.boneThreshold_hu,
+                               bone.error()));
+  }
+  return out;
+}
+
+Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expected_world_from_ct,
+                                              const ProgressMonitor& monitor) {
+  if (m_viewRenderersReady) return Ok{};
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::shared_ptr<const DrrRenderer>> renderers;
+  Status status = Ok{};
+  for (const View& view : m_views) {
+    auto created = DrrRendererFactory::createForView(m_drrVolume, m_drrOptions, view.camera, T_expected_world_from_ct,
+                                                     monitor);
+    if (!created) return fail(fmt::format("view '{}': {}", view.name, created.error()));
+    for (const std::string& warning : created.warnings()) status.addWarning(fmt::format("view '{}': {}", view.name, warning));
+    renderers.push_back(std::move(created).value());
+  }
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    m_views[v].renderer = renderers[v];
+    m_views[v].transgraph = dynamic_cast<const TransgraphRenderer*>(renderers[v].get());
+  }
+  m_viewRenderersReady = true;
+  m_viewRendererSetup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return status;
+}
+
+Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level,
+                                              const Eigen::Isometry3d& T_world_from_ct) const {
+  const Camera levelCamera = m_views[v].camera.downsampled(level);
+  const CameraIntrinsics& in = levelCamera.intrinsics();
+  const double depth_mm = (levelCamera.T_camera_from_world() * T_world_from_ct * m_centre_ct_mm).z();
+  const double footprint_mm = in.pixelSpacing_mm.minCoeff() * depth_mm / in.sourceToDetector_mm;
+  const Eigen::Vector3d& spacing_mm = m_drrVolume->values().spacing_mm();
+  Eigen::Vector3i block;
+  for (int a = 0; a < 3; ++a) block[a] = std::max(1, static_cast<int>(std::floor(footprint_mm / spacing_mm[a])));
+  return block;
+}
+
+Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int level,
+                                                           const Eigen::Isometry3d& T_world_from_ct) {
+  if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
+  const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct);
+  if ((block.array() == 1).all()) return m_renderer.get();
+  const std::array<int, 3> key{block.x(), block.y(), block.z()};
+  auto found = m_coarseRenderers.find(key);
+  if (found == m_coarseRenderers.end()) {
+    auto coarse = m_drrVolume->coarsened(block);
+    if (!coarse) return fail(coarse.error());
+    auto renderer = DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(coarse).value()),
+                                               exactRendererOptions(m_drrOptions));
+    if (!renderer) return fail(renderer.error());
+    found = m_coarseRenderers.emplace(key, std::move(renderer).value()).first;
+  }
+  return found->second.get();
+}
+
+Status RegistrationCase::checkViewLevel(std::size_t v, int level) const {
+  if (v >= m_views.size()) return fail(fmt::format("view index {} out of range (there are {})", v, m_views.size()));
+  const int levels = m_views[v].prepared.pyramid.levelCount();
+  if (level < 0 || level >= levels) {
+    return fail(fmt::format("view '{}': pyramid level {} does not exist; use 0 to {}", m_views[v].name, level,
+                            levels - 1));
+  }
+  return Ok{};
+}
+
+Result<const DynamicRoiSelector*> RegistrationCase::selector(std::size_t v, int level, int windowSize) {
+  if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
+  View& view = m_views[v];
+  const auto key = std::make_pair(level, windowSize);
+  auto found = view.selectors.find(key);
+  if (found == view.selectors.end()) {
+    const PyramidLevel& pyramidLevel = view.prepared.pyramid.level(level);
+    auto created = DynamicRoiSelector::create(pyramidLevel.image, pyramidLevel.mask, windowSize);
+    if (!created) return fail(fmt::format("view '{}', level {}: {}", view.name, level, created.error()));
+    found = view.selectors.emplace(key, std::move(created).value()).first;
+  }
+  return &found->second;
+}
+
+Result<RoiSelection> RegistrationCase::rois(std::size_t v, int level, int windowSize, double targetFraction) {
+  auto selector = this->selector(v, level, windowSize);
+  if (!selector) return fail(selector.error());
+  auto selection = selector.value()->selectFraction(targetFraction);
+  if (!selection) return fail(fmt::format("view '{}', level {}: {}", m_views[v].name, level, selection.error()));
+  return selection;
+}
+
+Result<RoiSelection> RegistrationCase::allWindows(std::size_t v, int level, int windowSize) {
+  auto selector = this->selector(v, level, windowSize);
+  if (!selector) return fail(selector.error());
+  return selector.value()->selectAll();
+}
+
+Status RegistrationCase::checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const {
+  for (const View& view : m_views) {
+    const int usedLevel = std::clamp(level, 0, view.prepared.pyramid.levelCount() - 1);
+    const PixelIndexList pixels = view.prepared.pyramid.level(usedLevel).mask.pixelList();
+    auto values = m_renderer->renderPixels(view.camera, T_world_from_ct, usedLevel, pixels);
+    if (!values) return fail(fmt::format("view '{}': {}", view.name, values.error()));
+    const bool empty = std::all_of(values.value().begin(), values.value().end(), [](float x) { return x == 0.0f; });
+    if (empty) {
+      return fail(fmt::format("view '{}': the CT at the initial pose projects outside the X-ray's {} valid pixels (the "
+                              "DRR is empty there), so DRR and X-ray do not overlap; check the initial pose, the "
+                              "landmarks or the view's camera",
+                              view.name, pixels.size()));
+    }
+  }
+  return Ok{};
+}
+
+Eigen::Isometry3d RegistrationCase::poseTransform(const PoseVector& params) const {
+  return RigidPose::toTransform(PoseParameters::fromVector(params), m_centre_ct_mm);
+}
+
+}  // namespace fct

@@ -1,0 +1,149 @@
+#pragma once
+// RegistrationCase: everything about one registration problem that is computed once and reused by every stage and
+// every pose: the CT prepared for DRRs and its renderers, each view's prepared X-ray (masks, line integrals, pyramid
+// with exact cameras), the dynamic-ROI statistics per view, level and window size (selections are then instant),
+// and the bone's centre (the rotation centre of the pose parameters) and radius (the parameter scales).
+//
+// Renderers: one per view. For the view-independent methods (siddon, raycast) every view shares the method's renderer.
+// For the transgraph method each view gets its own Transgraph (a ray table of that view's detector, valid for poses
+// near an expected pose, built or loaded from the disk cache) and the exact renderer is Siddon: it serves rays outside
+// a table (counted per render), the overlap check, and runs with the Transgraph switched off (ablation). A table is
+// read back at the pixel rays of any pyramid level: it stores rays, not pixels, and covers the full detector's extent.
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "Base/ProgressMonitor.h"
+#include "Base/Result.h"
+#include "Drr/DrrRenderer.h"
+#include "Drr/DrrRendererFactory.h"
+#include "Drr/TransgraphRenderer.h"
+#include "Geometry/Camera.h"
+#include "Geometry/PoseVector.h"
+#include "Image/BoneSurface.h"
+#include "Image/Volume.h"
+#include "Image/XrayImage.h"
+#include "Registration/RegistrationView.h"
+#include "Similarity/DynamicRoiSelector.h"
+#include "XrayPrep/XrayPreparation.h"
+
+namespace fct {
+
+/// How a case is prepared.
+struct RegistrationCaseOptions {
+  DrrRendererOptions drr;                  ///< DRR method ("siddon", "raycast", ...)
+  XrayPreparationOptions preparation;      ///< masks, intensity model, pyramid levels (spheres come per view)
+  double boneThreshold_hu = 250.0;         ///< iso-value of the bone surface giving the rotation centre and radius
+  /// Transgraph method: the pose (CT mm -> world mm, LPS) around which each view's table is built, e.g. the initial
+  /// pose from landmarks. nullopt: the tables are built at the initial pose of the first Registration::run.
+  std::optional<Eigen::Isometry3d> T_expected_world_from_ct;
+};
+
+/// A prepared registration problem: CT, renderer and views.
+class RegistrationCase {
+ public:
+  /// Prepares the CT and every view, and for the transgraph method with an expected pose each view's table (the
+  /// monitor sees the builds and can cancel them). Fails, naming the view, on no view, a camera whose detector differs
+  /// from its image, a failed X-ray preparation, an X-ray constant over its valid pixels (nothing to register
+  /// against), or a table that cannot be planned or built. A CT without bone above the threshold uses the volume
+  /// centre and a quarter of its diagonal (with a warning); Transgraph cache problems are warnings too.
+  static Result<RegistrationCase> create(const Volume& ct, const std::vector<RegistrationView>& views,
+                                         const RegistrationCaseOptions& options = {},
+                                         const ProgressMonitor& monitor = {});
+
+  /// The exact DRR renderer shared by all views: the method's renderer, Siddon for the transgraph method.
+  const DrrRenderer& renderer() const { return *m_renderer; }
+  /// The exact renderer for view v at pyramid `level` with the CT near pose T_world_from_ct: renderer()'s method over
+  /// the CT box-averaged to the level's pixel footprint (ctBlockSize()), so coarse levels traverse fewer, larger voxels
+  /// and their DRRs carry the blur of their pixels; renderer() itself where the block is one voxel. Coarse CTs are
+  /// made on first use and kept. Fails on a bad view or level.
+  Result<const DrrRenderer*> levelRenderer(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct);
+  /// The CT voxels per axis that levelRenderer() averages for view v at `level`: floor(pixel footprint / voxel
+  /// spacing), at least 1, where the footprint is the level's smaller pixel side scaled to the depth of the rotation
+  /// centre at T_world_from_ct (the pixel's size at the bone). v and level must be valid (levelRenderer checks them).
+  Eigen::Vector3i ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const;
+  /// The renderer of view v: its Transgraph once built (transgraph method), else renderer().
+  const DrrRenderer& renderer(std::size_t v) const { return *m_views[v].renderer; }
+  /// The Transgraph renderer of view v, or null (other method, or tables not built yet).
+  const TransgraphRenderer* transgraph(std::size_t v) const { return m_views[v].transgraph; }
+  /// The DRR method the case was prepared with.
+  DrrMethod drrMethod() const { return m_drrOptions.method; }
+  /// True when every view has its final renderer (always, except for the transgraph method before its tables exist).
+  bool viewRenderersReady() const { return m_viewRenderersReady; }
+  /// Transgraph method: builds (or loads from the cache) each view's table around T_expected_world_from_ct, unless
+  /// they exist already (then nothing changes: tables are built once per case). Other methods: nothing to do. Fails,
+  /// naming the view, when a table cannot be planned or built, or when the monitor cancels; cache problems are
+  /// warnings of the result.
+  Status prepareViewRenderers(const Eigen::Isometry3d& T_expected_world_from_ct, const ProgressMonitor& monitor = {});
+  /// Wall time of the table builds or cache loads of prepareViewRenderers(), seconds (0 for other methods).
+  double viewRendererSetupSeconds() const { return m_viewRendererSetup_s; }
+  /// Number of views.
+  std::size_t viewCount() const { return m_views.size(); }
+  /// Name of view v.
+  const std::string& viewName(std::size_t v) const { return m_views[v].name; }
+  /// The prepared X-ray of view v (pyramid levels with images, masks and cameras).
+  const PreparedXray& prepared(std::size_t v) const { return m_views[v].prepared; }
+  /// The full-resolution camera of view v.
+  const Camera& camera(std::size_t v) const { return m_views[v].camera; }
+  /// Number of pyramid levels of every view.
+  int levelCount() const { return m_views.front().prepared.pyramid.levelCount(); }
+
+  /// The bone iso-surface of the CT, if the CT has bone above the threshold.
+  const std::optional<BoneSurface>& bone() const { return m_bone; }
+  /// Rotation centre of the pose parameters, CT frame (LPS mm): the bone surface's centroid.
+  const Eigen::Vector3d& rotationCentre_ct_mm() const { return m_centre_ct_mm; }
+  /// Bone radius in mm used for the parameter scales.
+  double boneRadius_mm() const { return m_boneRadius_mm; }
+  /// Parameter scales (deg, mm per scaled unit) for the bone radius (PoseOptimizer::scalesForBoneRadius).
+  const PoseVector& scales() const { return m_scales; }
+
+  /// Dynamic ROIs of view v at `level`: the highest-variance windowSize^2 windows covering `targetFraction` of the
+  /// valid pixels (see DynamicRoiSelector). Window statistics are computed on first use and kept. Fails, naming the
+  /// view and level, on a bad level, window or fraction, or when no complete valid window exists.
+  Result<RoiSelection> rois(std::size_t v, int level, int windowSize, double targetFraction);
+  /// Every complete valid windowSize^2 window of view v at `level` (VLNC without dynamic ROIs); fails as rois().
+  Result<RoiSelection> allWindows(std::size_t v, int level, int windowSize);
+
+  /// Checks that the CT at `T_world_from_ct` projects onto the valid pixels of every view at `level`: fails, naming
+  /// the view, when the DRR is empty (zero) over all of them, i.e. the DRR and the X-ray do not overlap.
+  Status checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const;
+
+  /// T_world_from_ct of pose parameters about rotationCentre_ct_mm().
+  Eigen::Isometry3d poseTransform(const PoseVector& params) const;
+
+ private:
+  struct View {
+    std::string name;
+    Camera camera;
+    PreparedXray prepared;
+    std::map<std::pair<int, int>, DynamicRoiSelector> selectors;  ///< by (level, window size)
+    std::shared_ptr<const DrrRenderer> renderer;                  ///< the view's renderer (see renderer(v))
+    const TransgraphRenderer* transgraph = nullptr;               ///< the same renderer when it is a Transgraph
+  };
+  /// Fails, naming the view, unless v is a view index and level one of its pyramid levels.
+  Status checkViewLevel(std::size_t v, int level) const;
+  /// The ROI statistics of view v at (level, window), computed on first use.
+  Result<const DynamicRoiSelector*> selector(std::size_t v, int level, int windowSize);
+
+  std::shared_ptr<const DrrVolume> m_drrVolume;
+  std::shared_ptr<const DrrRenderer> m_renderer;
+  std::map<std::array<int, 3>, std::shared_ptr<const DrrRenderer>> m_coarseRenderers;  ///< by CT block size
+  DrrRendererOptions m_drrOptions;
+  bool m_viewRenderersReady = true;
+  double m_viewRendererSetup_s = 0.0;
+  std::vector<View> m_views;
+  std::optional<BoneSurface> m_bone;
+  Eigen::Vector3d m_centre_ct_mm = Eigen::Vector3d::Zero();
+  double m_boneRadius_mm = 0.0;
+  PoseVector m_scales = PoseVector::Ones();
+};
+
+}  // namespace fct

@@ -1,0 +1,155 @@
+#include "Registration/RegistrationObjective.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+#include "Similarity/GradientCorrelationSimilarity.h"
+#include "Similarity/NccSimilarity.h"
+#include "Similarity/VlncSimilarity.h"
+
+namespace fct {
+
+namespace {
+
+/// The pixels of `pixels` (linear indices of a level `cols` wide) on every k-th column and row, k the smallest stride
+/// that keeps at most maxPixels of them (approximately: the valid pixels are assumed evenly spread).
+PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int maxPixels) {
+  if (pixels.size() <= static_cast<std::size_t>(maxPixels)) return pixels;
+  const int k = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(pixels.size()) / maxPixels)));
+  PixelIndexList kept;
+  kept.reserve(pixels.size() / (static_cast<std::size_t>(k) * k) + 1);
+  for (const std::int32_t index : pixels) {
+    if ((index % cols) % k == 0 && (index / cols) % k == 0) kept.push_back(index);
+  }
+  return kept;
+}
+
+}  // namespace
+
+Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
+                                                            const RegistrationStage& stage, bool useViewRenderers,
+                                                            const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct) {
+  RegistrationObjective objective;
+  objective.m_level = stage.level;
+  const int level = stage.level;
+  auto where = [&](std::size_t v) { return fmt::format("stage '{}', view '{}'", stage.name, registrationCase.viewName(v)); };
+  if (level < 0 || level >= registrationCase.levelCount()) {
+    return fail(fmt::format("stage '{}' uses pyramid level {} but the X-rays have levels 0 to {}; change the preset or "
+                            "prepare more levels",
+                            stage.name, level, registrationCase.levelCount() - 1));
+  }
+  for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
+    const PyramidLevel& pyramidLevel = registrationCase.prepared(v).pyramid.level(level);
+    View view;
+    view.renderer = useViewRenderers ? &registrationCase.renderer(v) : &registrationCase.renderer();
+    const bool tableRenderer = useViewRenderers && registrationCase.transgraph(v) != nullptr;
+    if (!tableRenderer && T_coarseCt_world_from_ct) {
+      auto levelRenderer = registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct);
+      if (!levelRenderer) return fail(fmt::format("{}: {}", where(v), levelRenderer.error()));
+      view.renderer = levelRenderer.value();
+    }
+    view.camera = registrationCase.camera(v);
+    const std::size_t validCount = pyramidLevel.mask.validCount();
+
+    // The pixel set: windows for VLNC and for ROIs, the valid pixels otherwise.
+    const bool windows = stage.metric == SimilarityMetric::Vlnc || stage.pixels.kind == PixelSetKind::Rois;
+    RoiSelection selection;
+    if (windows) {
+      auto selected = stage.pixels.kind == PixelSetKind::Rois
+                          ? registrationCase.rois(v, level, stage.pixels.windowSize, stage.pixels.targetFraction)
+                          : registrationCase.allWindows(v, level, stage.pixels.windowSize);
+      if (!selected) return fail(fmt::format("stage '{}': {}", stage.name, selected.error()));
+      selection = std::move(selected).value();
+      view.pixels = selection.pixels;
+    } else {
+      view.pixels = pyramidLevel.mask.pixelList();
+      if (stage.pixels.maxPixels > 0) view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stage.pixels.maxPixels);
+    }
+    if (view.pixels.empty()) {
+      return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}); reduce the masks or use a "
+                              "finer level",
+                              where(v), level));
+    }
+    view.keptFraction = validCount ? static_cast<double>(view.pixels.size()) / static_cast<double>(validCount) : 0.0;
+
+    switch (stage.metric) {
+      case SimilarityMetric::Ncc: {
+        auto metric = NccSimilarity::create(pyramidLevel.image, view.pixels);
+        if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
+        view.metric = std::make_unique<NccSimilarity>(std::move(metric).value());
+        break;
+      }
+      case SimilarityMetric::Vlnc: {
+        auto metric = VlncSimilarity::create(pyramidLevel.image, selection);
+        if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
+        view.metric = std::make_unique<VlncSimilarity>(std::move(metric).value());
+        break;
+      }
+      case SimilarityMetric::GradientCorrelation: {
+        auto metric = GradientCorrelationSimilarity::create(pyramidLevel.image, view.pixels);
+        if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
+        view.metric = std::make_unique<GradientCorrelationSimilarity>(std::move(metric).value());
+        view.wholeLevel = true;
+        break;
+      }
+    }
+    view.drr = FloatImage::filled(pyramidLevel.image.cols, pyramidLevel.image.rows, 0.0f);
+    view.values.reserve(view.pixels.size());
+    objective.m_views.push_back(std::move(view));
+  }
+  return objective;
+}
+
+Result<double> RegistrationObjective::similarity(const Eigen::Isometry3d& T_world_from_ct) {
+  tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
+    View& view = m_views[v];
+    DrrRenderStats stats;
+    if (view.wholeLevel) {
+      view.status = view.renderer->render(view.camera, T_world_from_ct, m_level, view.drr, &stats);
+    } else {
+      view.status =
+          view.renderer->renderPixels(view.camera, T_world_from_ct, m_level, view.pixels, view.values, &stats);
+      if (view.status) {
+        for (std::size_t i = 0; i < view.pixels.size(); ++i) view.drr.pixels[view.pixels[i]] = view.values[i];
+      }
+    }
+    if (!view.status) return;
+    view.fallbackRays = stats.fallbackRays;
+    auto score = view.metric->evaluate(view.drr);
+    if (!score) {
+      view.status = fail(score.error());
+      return;
+    }
+    view.score = score.value();
+  });
+  m_drrCount += static_cast<long>(m_views.size());
+  double sum = 0.0;
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    if (!m_views[v].status) return fail(m_views[v].status.error());
+    m_fallbackRays += static_cast<long>(m_views[v].fallbackRays);
+    sum += m_views[v].score;
+  }
+  return sum / static_cast<double>(m_views.size());
+}
+
+std::string_view RegistrationObjective::drrMethodName() const {
+  return m_views.empty() ? std::string_view() : m_views.front().renderer->methodName();
+}
+
+std::vector<double> RegistrationObjective::keptFractions() const {
+  std::vector<double> fractions;
+  for (const View& view : m_views) fractions.push_back(view.keptFraction);
+  return fractions;
+}
+
+std::vector<std::size_t> RegistrationObjective::renderedPixelCounts() const {
+  std::vector<std::size_t> counts;
+  for (const View& view : m_views) {
+    counts.push_back(view.wholeLevel ? view.drr.pixels.size() : view.pixels.size());
+  }
+  return counts;
+}
+
+}  // namespace fct

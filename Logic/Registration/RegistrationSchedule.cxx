@@ -1,0 +1,279 @@
+#include "Registration/RegistrationSchedule.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "Base/JsonDocument.h"
+#include "Base/JsonReader.h"
+#include "RegistrationPresetsEmbedded.h"
+
+namespace fct {
+
+namespace {
+
+template <typename Enum, std::size_t N>
+Enum parseName(JsonReader& reader, std::string_view key, const std::array<std::pair<std::string_view, Enum>, N>& names) {
+  const std::string text = reader.string(key);
+  if (!reader.ok()) return names[0].second;
+  for (const auto& [name, value] : names) {
+    if (text == name) return value;
+  }
+  std::vector<std::string_view> accepted;
+  for (const auto& entry : names) accepted.push_back(entry.first);
+  reader.rejectKey(key, fmt::format("is '{}'; use one of {}", text, fmt::join(accepted, ", ")));
+  return names[0].second;
+}
+
+constexpr std::array<std::pair<std::string_view, SimilarityMetric>, 3> kMetrics{
+    {{"ncc", SimilarityMetric::Ncc}, {"vlnc", SimilarityMetric::Vlnc}, {"gc", SimilarityMetric::GradientCorrelation}}};
+constexpr std::array<std::pair<std::string_view, SearchStrategy>, 3> kSearches{
+    {{"genetic", SearchStrategy::Genetic}, {"cmaes", SearchStrategy::CmaEs}, {"local", SearchStrategy::Local}}};
+constexpr std::array<std::pair<std::string_view, PixelSetKind>, 2> kPixelSets{
+    {{"whole", PixelSetKind::WholeImage}, {"rois", PixelSetKind::Rois}}};
+
+/// Reads an optional number into `value` (kept when the key is absent).
+void optionalNumber(JsonReader& reader, std::string_view key, double& value) {
+  if (reader.has(key)) value = reader.number(key);
+}
+void optionalInteger(JsonReader& reader, std::string_view key, int minimum, int& value) {
+  if (reader.has(key)) value = reader.integer(key, minimum);
+}
+
+void readSimplex(const nlohmann::json& object, const std::string& where, JsonReader& parent, NelderMeadOptions& o) {
+  JsonReader reader(object, where);
+  optionalNumber(reader, "initial_step", o.initialStep);
+  optionalNumber(reader, "tolerance", o.tolerance);
+  optionalInteger(reader, "max_evaluations", 1, o.maxEvaluations);
+  optionalInteger(reader, "restarts", 0, o.restarts);
+  parent.adoptError(reader);
+}
+
+void readCmaEs(const nlohmann::json& object, const std::string& where, JsonReader& parent, CmaEsOptions& o) {
+  JsonReader reader(object, where);
+  optionalNumber(reader, "sigma", o.initialSigma);
+  optionalNumber(reader, "tolerance", o.tolerance);
+  optionalInteger(reader, "population", 0, o.populationSize);
+  optionalInteger(reader, "max_evaluations", 1, o.maxEvaluations);
+  if (reader.has("seed")) o.seed = static_cast<std::uint32_t>(reader.integer("seed", 0));
+  parent.adoptError(reader);
+}
+
+Result<RegistrationStage> readStage(const nlohmann::json& object, const std::string& where) {
+  RegistrationStage stage;
+  JsonReader reader(object, where);
+  stage.name = reader.string("name");
+  stage.metric = parseName(reader, "metric", kMetrics);
+  stage.level = reader.integer("level", 0);
+  if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
+  if (const nlohmann::json* exact = reader.find("exact_drr")) {
+    if (exact->is_boolean()) {
+      stage.exactDrr = exact->get<bool>();
+    } else {
+      reader.rejectKey("exact_drr", fmt::format("is {}; use true or false", JsonReader::describe(*exact)));
+    }
+  }
+
+  if (const nlohmann::json* pixels = reader.find("pixels")) {
+    JsonReader pixelReader(*pixels, where + ": pixels");
+    stage.pixels.kind = parseName(pixelReader, "set", kPixelSets);
+    optionalInteger(pixelReader, "window", 2, stage.pixels.windowSize);
+    optionalNumber(pixelReader, "fraction", stage.pixels.targetFraction);
+    optionalInteger(pixelReader, "max_pixels", 0, stage.pixels.maxPixels);
+    if (pixelReader.ok() && stage.pixels.windowSize > 64) {
+      pixelReader.rejectKey("window", fmt::format("is {}; use 2 to 64 pixels", stage.pixels.windowSize));
+    }
+    if (pixelReader.ok() && !(stage.pixels.targetFraction > 0.0 && stage.pixels.targetFraction <= 1.0)) {
+      pixelReader.rejectKey("fraction", fmt::format("is {}; use 0 < fraction <= 1 (the paper: 0.10 to 0.15)",
+                                                    stage.pixels.targetFraction));
+    }
+    reader.adoptError(pixelReader);
+  } else {
+    reader.rejectKey("pixels", "is missing; give {\"set\": \"whole\"} or {\"set\": \"rois\", \"window\": 7, "
+                               "\"fraction\": 0.12}");
+  }
+
+  if (const nlohmann::json* search = reader.find("search")) {
+    const std::string searchWhere = where + ": search";
+    JsonReader s(*search, searchWhere);
+    stage.search = parseName(s, "strategy", kSearches);
+    stage.maxEvaluations = s.integer("max_evaluations", 1);
+    GeneticSearchOptions& g = stage.genetic;
+    optionalInteger(s, "guesses", 1, g.randomGuesses);
+    optionalNumber(s, "spread_deg", g.spreadRotation_deg);
+    optionalNumber(s, "spread_mm", g.spreadTranslation_mm);
+    optionalNumber(s, "drop", g.dropThreshold);
+    optionalNumber(s, "extrapolation", g.extrapolation);
+    optionalInteger(s, "generations", 0, g.maxGenerations);
+    if (s.has("seed")) g.seed = static_cast<std::uint32_t>(s.integer("seed", 0));
+    if (const nlohmann::json* simplex = s.find("simplex")) readSimplex(*simplex, searchWhere + ".simplex", s, stage.simplex);
+    if (const nlohmann::json* cmaes = s.find("cmaes")) readCmaEs(*cmaes, searchWhere + ".cmaes", s, stage.cmaes);
+    reader.adoptError(s);
+  } else {
+    reader.rejectKey("search", "is missing; give at least {\"strategy\": \"local\", \"max_evaluations\": 500}");
+  }
+  if (!reader.ok()) return fail(reader.error());
+
+  stage.genetic.maxEvaluations = stage.maxEvaluations;
+  stage.genetic.local = stage.simplex;
+  for (const Status& status : {NelderMeadOptimizer(stage.simplex).validateOptions(),
+                               GeneticSearchOptimizer(stage.genetic).validateOptions(),
+                               CmaEsOptimizer(stage.cmaes).validateOptions()}) {
+    if (!status) return fail(fmt::format("{}: {}", where, status.error()));
+  }
+  return stage;
+}
+
+template <typename Enum, std::size_t N>
+std::string_view nameOf(Enum value, const std::array<std::pair<std::string_view, Enum>, N>& names) {
+  for (const auto& [name, v] : names) {
+    if (v == value) return name;
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+std::vector<std::string> RegistrationAblation::activeNames() const {
+  std::vector<std::string> names;
+  if (noDynamicRois) names.emplace_back("no-rois");
+  if (noPyramid) names.emplace_back("no-pyramid");
+  if (nccOnly) names.emplace_back("ncc-only");
+  if (localOnly) names.emplace_back("local-only");
+  if (cmaesForGenetic) names.emplace_back("cmaes");
+  if (noTransgraph) names.emplace_back("no-transgraph");
+  if (noCtPyramid) names.emplace_back("no-ct-pyramid");
+  return names;
+}
+
+std::string_view RegistrationSchedule::metricName(SimilarityMetric metric) { return nameOf(metric, kMetrics); }
+std::string_view RegistrationSchedule::searchName(SearchStrategy search) { return nameOf(search, kSearches); }
+
+std::vector<std::string> RegistrationSchedule::builtinNames() {
+  std::vector<std::string> names;
+  for (const auto& [name, text] : embedded::kRegistrationPresets) names.emplace_back(name);
+  return names;
+}
+
+Result<RegistrationSchedule> RegistrationSchedule::builtin(std::string_view name) {
+  for (const auto& [presetName, text] : embedded::kRegistrationPresets) {
+    if (presetName != name) continue;
+    const std::string where = fmt::format("built-in preset '{}'", name);
+    auto document = JsonDocument::parseText(std::string(text), where);
+    if (!document) return fail(document.error());
+    return fromJson(document.value(), where);
+  }
+  return fail(fmt::format("unknown registration preset '{}'; use one of {} or a preset file (.json)", name,
+                          fmt::join(builtinNames(), ", ")));
+}
+
+Result<RegistrationSchedule> RegistrationSchedule::readFile(const std::filesystem::path& path) {
+  auto document = JsonDocument::parse(path);
+  if (!document) return fail(document.error());
+  return fromJson(document.value(), path.string());
+}
+
+Result<RegistrationSchedule> RegistrationSchedule::resolve(const std::string& nameOrPath) {
+  for (const std::string& name : builtinNames()) {
+    if (name == nameOrPath) return builtin(name);
+  }
+  if (!std::filesystem::exists(nameOrPath)) {
+    return fail(fmt::format("'{}' is neither a built-in preset ({}) nor an existing preset file", nameOrPath,
+                            fmt::join(builtinNames(), ", ")));
+  }
+  return readFile(nameOrPath);
+}
+
+Result<RegistrationSchedule> RegistrationSchedule::fromJson(const nlohmann::json& document, const std::string& where) {
+  JsonReader reader(document, where);
+  RegistrationSchedule schedule;
+  schedule.name = reader.string("name");
+  if (const nlohmann::json* description = reader.find("description"); description && description->is_string()) {
+    schedule.description = description->get<std::string>();
+  }
+  const nlohmann::json* stages = reader.find("stages");
+  if (reader.ok() && (!stages || !stages->is_array() || stages->empty())) {
+    reader.rejectKey("stages", "must be a non-empty array of stages");
+  }
+  if (!reader.ok()) return fail(reader.error());
+  for (std::size_t i = 0; i < stages->size(); ++i) {
+    auto stage = readStage((*stages)[i], fmt::format("{}: stages[{}]", where, i));
+    if (!stage) return fail(stage.error());
+    schedule.stages.push_back(std::move(stage).value());
+  }
+  return schedule;
+}
+
+nlohmann::ordered_json RegistrationSchedule::toJson() const {
+  nlohmann::ordered_json stagesJson = nlohmann::ordered_json::array();
+  for (const RegistrationStage& s : stages) {
+    nlohmann::ordered_json pixels{{"set", nameOf(s.pixels.kind, kPixelSets)}, {"window", s.pixels.windowSize}};
+    if (s.pixels.kind == PixelSetKind::Rois) pixels["fraction"] = s.pixels.targetFraction;
+    if (s.pixels.maxPixels > 0) pixels["max_pixels"] = s.pixels.maxPixels;
+    nlohmann::ordered_json search{{"strategy", searchName(s.search)}, {"max_evaluations", s.maxEvaluations}};
+    search["guesses"] = s.genetic.randomGuesses;
+    search["spread_deg"] = s.genetic.spreadRotation_deg;
+    search["spread_mm"] = s.genetic.spreadTranslation_mm;
+    search["drop"] = s.genetic.dropThreshold;
+    search["extrapolation"] = s.genetic.extrapolation;
+    search["generations"] = s.genetic.maxGenerations;
+    search["seed"] = s.genetic.seed;
+    search["simplex"] = {{"initial_step", s.simplex.initialStep},
+                         {"tolerance", s.simplex.tolerance},
+                         {"max_evaluations", s.simplex.maxEvaluations},
+                         {"restarts", s.simplex.restarts}};
+    search["cmaes"] = {{"sigma", s.cmaes.initialSigma},
+                       {"tolerance", s.cmaes.tolerance},
+                       {"population", s.cmaes.populationSize},
+                       {"max_evaluations", s.cmaes.maxEvaluations},
+                       {"seed", s.cmaes.seed}};
+    stagesJson.push_back({{"name", s.name},
+                          {"metric", metricName(s.metric)},
+                          {"level", s.level},
+                          {"exact_drr", s.exactDrr},
+                          {"pixels", std::move(pixels)},
+                          {"search", std::move(search)}});
+  }
+  return nlohmann::ordered_json{{"name", name}, {"description", description}, {"stages", std::move(stagesJson)}};
+}
+
+RegistrationSchedule RegistrationSchedule::withAblation(const RegistrationAblation& ablation) const {
+  RegistrationSchedule result = *this;
+  const auto active = ablation.activeNames();
+  if (!active.empty()) result.name = fmt::format("{} ({})", name, fmt::join(active, ", "));
+  for (RegistrationStage& stage : result.stages) {
+    if (ablation.noDynamicRois) stage.pixels.kind = PixelSetKind::WholeImage;
+    if (ablation.noPyramid) stage.level = 0;
+    if (ablation.nccOnly) stage.metric = SimilarityMetric::Ncc;
+    if (ablation.localOnly) stage.search = SearchStrategy::Local;
+    if (ablation.cmaesForGenetic && stage.search == SearchStrategy::Genetic) stage.search = SearchStrategy::CmaEs;
+  }
+  return result;
+}
+
+RegistrationSchedule RegistrationSchedule::withSeed(std::uint32_t seed) const {
+  RegistrationSchedule result = *this;
+  for (std::size_t i = 0; i < result.stages.size(); ++i) {
+    result.stages[i].genetic.seed = seed + static_cast<std::uint32_t>(i);
+    result.stages[i].cmaes.seed = seed + static_cast<std::uint32_t>(i);
+  }
+  return result;
+}
+
+Result<RegistrationSchedule> RegistrationSchedule::withRoiPixels(int windowSize, double targetFraction) const {
+  if (windowSize < 2 || windowSize > 64) {
+    return fail(fmt::format("ROI window size {} px is outside 2 to 64 px; choose a window in that range", windowSize));
+  }
+  if (!(targetFraction > 0.0 && targetFraction <= 1.0)) {
+    return fail(fmt::format("ROI fraction {} is outside (0, 1]; the paper keeps 0.10 to 0.15 of the pixels",
+                            targetFraction));
+  }
+  RegistrationSchedule result = *this;
+  for (RegistrationStage& stage : result.stages) {
+    if (stage.pixels.kind != PixelSetKind::Rois) continue;
+    stage.pixels.windowSize = windowSize;
+    stage.pixels.targetFraction = targetFraction;
+  }
+  return result;
+}
+
+}  // namespace fct

@@ -1,0 +1,111 @@
+#pragma once
+// RegistrationSchedule: the registration pipeline as data: an ordered list of stages, each naming a similarity
+// metric, a pyramid level, the pixel set compared and the search strategy with its options. The built-in presets
+// ("paper", "fast") are the JSON files of Resources/presets, embedded into the binary at build time; a user file
+// with the same schema is loaded the same way (README "Registration presets" documents the keys).
+//
+// Ablation switches turn one technique of the paper off at a time (withAblation), so its effect can be measured.
+
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "Base/Result.h"
+#include "Search/CmaEsOptimizer.h"
+#include "Search/GeneticSearchOptimizer.h"
+#include "Search/NelderMeadOptimizer.h"
+
+namespace fct {
+
+/// The similarity of a stage (per view; the objective is over all views).
+enum class SimilarityMetric { Ncc, Vlnc, GradientCorrelation };
+/// Which pixels of each view a stage compares.
+enum class PixelSetKind {
+  WholeImage,  ///< every valid pixel (NCC, GC); for VLNC every complete valid w x w window
+  Rois,        ///< the dynamic ROIs: the highest-variance w x w windows covering a target fraction of valid pixels
+};
+/// The search strategy of a stage.
+enum class SearchStrategy { Genetic, CmaEs, Local };
+
+/// The pixel set of a stage.
+struct PixelSetSpec {
+  PixelSetKind kind = PixelSetKind::WholeImage;
+  int windowSize = 7;            ///< w, pixels of the stage's level (ROIs, and VLNC windows of a whole image)
+  double targetFraction = 0.12;  ///< ROIs: fraction of the valid pixels kept (0 < f <= 1; the paper: 0.10-0.15)
+  /// Whole-image NCC/GC sets: at most this many pixels per view, by keeping every k-th column and row (k as small as
+  /// fits); 0 = no cap. A large detector's coarse level then costs like a small one's (VLNC and ROI sets ignore it).
+  int maxPixels = 0;
+};
+
+/// One stage of the schedule. Option units follow the optimizers: scaled units (about 1 mm of bone-surface motion),
+/// except the genetic spreads (deg, mm). The genetic drop threshold is in similarity units (mean over views).
+struct RegistrationStage {
+  std::string name;
+  SimilarityMetric metric = SimilarityMetric::Ncc;
+  int level = 0;                   ///< pyramid level: 0 = full resolution, 2 = 1:16 pixels
+  /// Render with the case's exact renderer even when it has per-view Transgraphs (whose interpolation smooths detail
+  /// finer than the table spacing: measured too coarse for the full-resolution stage, see README).
+  bool exactDrr = false;
+  PixelSetSpec pixels;
+  SearchStrategy search = SearchStrategy::Local;
+  int maxEvaluations = 1000;       ///< cap on DRR sets (one per view) of the stage's search
+  GeneticSearchOptions genetic;    ///< used by Genetic (its `local` is the simplex below)
+  CmaEsOptions cmaes;              ///< used by CmaEs
+  NelderMeadOptions simplex;       ///< the local search: alone (Local) or inside each genetic guess
+};
+
+/// Ablation switches: each one true turns a technique of the paper off (defaults: everything on). The five techniques
+/// of the paper are dynamic ROIs, the pyramid, the Transgraph, NCC -> VLNC and the genetic search (localOnly);
+/// noTransgraph acts on the case's renderers (Registration), the others on the stages (withAblation).
+struct RegistrationAblation {
+  bool noDynamicRois = false;      ///< ROIs -> every valid pixel (VLNC: every complete window)
+  bool noPyramid = false;          ///< every stage at level 0
+  bool nccOnly = false;            ///< NCC in every stage (no switch to VLNC)
+  bool localOnly = false;          ///< every global search replaced by the local simplex
+  bool cmaesForGenetic = false;    ///< CMA-ES wherever the schedule says genetic
+  bool noTransgraph = false;       ///< exact (Siddon) DRRs instead of the per-view Transgraphs (transgraph method)
+  bool noCtPyramid = false;        ///< exact DRRs of every level integrate the full CT (not one coarsened to the level)
+
+  /// Names of the switches that are on, for reports ("no-rois", "no-pyramid", ...).
+  std::vector<std::string> activeNames() const;
+};
+
+/// An ordered list of registration stages.
+class RegistrationSchedule {
+ public:
+  /// Names of the built-in presets, e.g. {"fast", "paper"}.
+  static std::vector<std::string> builtinNames();
+  /// A built-in preset by name; the error lists the names.
+  static Result<RegistrationSchedule> builtin(std::string_view name);
+  /// Reads a schedule file (JSON, schema of the built-in presets); the error names the file, stage and key.
+  static Result<RegistrationSchedule> readFile(const std::filesystem::path& path);
+  /// A built-in preset when `nameOrPath` is one of builtinNames(), else readFile(nameOrPath).
+  static Result<RegistrationSchedule> resolve(const std::string& nameOrPath);
+  /// Parses a schedule from JSON; `where` names the source in messages. Fails on a missing or bad key, no stage,
+  /// a level outside 0..7, a window outside 2..64, a fraction outside (0, 1], or invalid optimizer options.
+  static Result<RegistrationSchedule> fromJson(const nlohmann::json& document, const std::string& where);
+
+  /// The schedule in the JSON schema fromJson() reads (a round trip gives an equal schedule).
+  nlohmann::ordered_json toJson() const;
+  /// This schedule with the given techniques switched off (see RegistrationAblation); the name gets a suffix.
+  RegistrationSchedule withAblation(const RegistrationAblation& ablation) const;
+  /// This schedule with every stage's random seed derived from `seed` (stage i gets seed + i).
+  RegistrationSchedule withSeed(std::uint32_t seed) const;
+  /// This schedule with every ROI stage's window size and target fraction replaced (e.g. by the user's tuning);
+  /// stages on whole images are unchanged. Fails on a window outside 2..64 or a fraction outside (0, 1].
+  Result<RegistrationSchedule> withRoiPixels(int windowSize, double targetFraction) const;
+
+  /// Lowercase name of a metric ("ncc", "vlnc", "gc").
+  static std::string_view metricName(SimilarityMetric metric);
+  /// Lowercase name of a strategy ("genetic", "cmaes", "local").
+  static std::string_view searchName(SearchStrategy search);
+
+  std::string name;
+  std::string description;
+  std::vector<RegistrationStage> stages;
+};
+
+}  // namespace fct

@@ -1,0 +1,76 @@
+#include "Similarity/VlncSimilarity.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "Similarity/NccAccumulator.h"
+
+namespace fct {
+
+Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiSelection& selection) {
+  const int w = selection.windowSize;
+  if (selection.windows.empty() || w <= 0) {
+    return fail("VLNC needs at least one window; the ROI selection is empty (lower the threshold or raise the "
+                "target fraction)");
+  }
+  VlncSimilarity metric;
+  metric.m_cols = xray.cols;
+  metric.m_rows = xray.rows;
+  metric.m_windowPixels = static_cast<std::size_t>(w) * w;
+  std::vector<float> values(metric.m_windowPixels);
+  PixelIndexList indices(metric.m_windowPixels);
+  double varianceSum = 0.0;
+  for (const RoiWindow& window : selection.windows) {
+    if (window.col0 < 0 || window.row0 < 0 || window.col0 + w > xray.cols || window.row0 + w > xray.rows) {
+      return fail(fmt::format("VLNC window at ({},{}) of size {} is not inside the {}x{} X-ray; select the ROIs on "
+                              "this image",
+                              window.col0, window.row0, w, xray.cols, xray.rows));
+    }
+    std::size_t k = 0;
+    for (int r = window.row0; r < window.row0 + w; ++r) {
+      for (int c = window.col0; c < window.col0 + w; ++c, ++k) {
+        indices[k] = r * xray.cols + c;
+        values[k] = xray.pixels[static_cast<std::size_t>(indices[k])];
+      }
+    }
+    const double norm = NccAccumulator::centreInPlace(values.data(), values.size());
+    if (!std::isfinite(norm)) {
+      return fail(fmt::format("X-ray has non-finite values in the window at ({},{})", window.col0, window.row0));
+    }
+    if (norm == 0.0) continue;  // constant X-ray window: weight 0
+    metric.m_pixels.insert(metric.m_pixels.end(), indices.begin(), indices.end());
+    metric.m_xrayCentred.insert(metric.m_xrayCentred.end(), values.begin(), values.end());
+    metric.m_xrayNorms.push_back(norm);
+    metric.m_weights.push_back(norm * norm);  // n * variance; n is common to all windows
+    varianceSum += norm * norm;
+  }
+  for (double& weight : metric.m_weights) weight /= varianceSum;
+  Result<VlncSimilarity> result(std::move(metric));
+  if (result.value().m_weights.empty()) {
+    result.addWarning("the X-ray is constant in every VLNC window; VLNC will be 0 for every pose");
+  }
+  return result;
+}
+
+Result<double> VlncSimilarity::evaluate(const FloatImage& drr) const {
+  if (drr.cols != m_cols || drr.rows != m_rows || drr.pixels.size() != static_cast<std::size_t>(m_cols) * m_rows) {
+    return fail(fmt::format("DRR is {}x{} but the X-ray is {}x{}; render the DRR with this view's camera at the same "
+                            "pyramid level",
+                            drr.cols, drr.rows, m_cols, m_rows));
+  }
+  const float* d = drr.pixels.data();
+  const std::size_t m = m_windowPixels;
+  double vlnc = 0.0;
+  for (std::size_t window = 0; window < m_weights.size(); ++window) {
+    const std::int32_t* index = m_pixels.data() + window * m;
+    const float* x = m_xrayCentred.data() + window * m;
+    NccAccumulator sums(d[index[0]]);
+    for (std::size_t i = 0; i < m; ++i) sums.add(x[i], d[index[i]]);
+    vlnc += m_weights[window] * sums.correlation(m_xrayNorms[window], m);
+  }
+  if (std::isnan(vlnc)) return fail("DRR has non-finite values in the compared windows");
+  return std::clamp(vlnc, -1.0, 1.0);
+}
+
+}  // namespace fct

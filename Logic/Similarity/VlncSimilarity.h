@@ -1,0 +1,41 @@
+#pragma once
+// VlncSimilarity: variance-weighted local NCC (Knaan & Joskowicz 2003). Over windows W (e.g. the dynamic ROIs):
+//     VLNC = sum_w  omega_w * NCC_w,     omega_w = var_x(w) / sum_v var_x(v),
+// NCC_w the NCC of X-ray and DRR over the pixels of window w, var_x(w) the population variance of the X-ray in w.
+// Windows where the X-ray is constant have weight 0 and are skipped; a window where the DRR is constant has
+// NCC_w = 0. VLNC is in [-1, 1] and invariant to a gain and offset of either image (and to a different offset per
+// window). If every window's X-ray is constant, VLNC is 0 for every DRR.
+
+#include <cstddef>
+#include <vector>
+
+#include "Base/Result.h"
+#include "Image/FloatImage.h"
+#include "Similarity/DynamicRoiSelector.h"
+#include "Similarity/ImageSimilarity.h"
+
+namespace fct {
+
+/// VLNC over fixed windows of one view.
+class VlncSimilarity final : public ImageSimilarity {
+ public:
+  /// Prepares the X-ray side over the windows of `selection` (their position and size; weights are recomputed from
+  /// `xray`). Fails on no window or a window not inside the image. All-constant windows give a warning.
+  static Result<VlncSimilarity> create(const FloatImage& xray, const RoiSelection& selection);
+
+  Result<double> evaluate(const FloatImage& drr) const override;
+  std::string name() const override { return "VLNC"; }
+  /// Number of windows with a nonzero weight.
+  std::size_t windowCount() const { return m_weights.size(); }
+
+ private:
+  int m_cols = 0;
+  int m_rows = 0;
+  std::size_t m_windowPixels = 0;    ///< w*w
+  PixelIndexList m_pixels;           ///< window by window, m_windowPixels each
+  std::vector<float> m_xrayCentred;  ///< X-ray values minus their window's mean, same layout
+  std::vector<double> m_xrayNorms;   ///< per window
+  std::vector<double> m_weights;     ///< per window, summing to 1
+};
+
+}  // namespace fct

@@ -1,0 +1,357 @@
+#include "Simulation/FluoroscopySimulator.h"
+
+#include <fmt/core.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+
+#include "Base/SeededRandom.h"
+#include "Simulation/ForeignObjectSet.h"
+#include "Simulation/IntensifierDistortion.h"
+#include "Simulation/Physics/MaterialPathTracer.h"
+#include "Simulation/Physics/XraySpectrum.h"
+
+namespace fct {
+
+namespace {
+
+/// What every view of a case shares: the spectrum with its attenuation table, the CT tracer and the implants.
+struct Scene {
+  XraySpectrum spectrum;
+  std::vector<MassPaths> massAttenuation_cm2_per_g;  ///< per bin, per material
+  MaterialPathTracer tracer;
+  ForeignObjectSet implants;  ///< CT frame
+};
+
+/// One rendered view.
+struct RenderedView {
+  FloatImage image;
+  std::vector<PixelCircle> spheres;   ///< shadows of the calibration spheres (observed pixels)
+  std::optional<DisplacementField> field;   ///< when distorted
+  double maxLineIntegral = 0.0;             ///< -ln of the smallest noiseless signal inside the collimator
+  double referenceSignal = 1.0;             ///< noiseless signal mapped to `gain` (1 = an unattenuated ray)
+};
+
+/// The spectrum settings inside the simulator's options.
+SpectrumOptions spectrumOptions(const FluoroscopyOptions& o) {
+  return {o.tubeVoltage_kvp, o.filtration_mmAl, o.spectrumBinWidth_keV, o.monochromatic_keV};
+}
+
+/// Checks the detector and placement settings (the spectrum, HU model, distortion and objects check their own).
+Status validate(const FluoroscopyOptions& o) {
+  const auto bad = [](double v, double low, double high) { return !(v >= low && v <= high); };
+  if (bad(o.photonsPerPixel, 0.0, 1e9)) {
+    return fail(fmt::format("dose must be 0 (noiseless) or a positive photon count per pixel up to 1e9, got {}",
+                            o.photonsPerPixel));
+  }
+  if (bad(o.psfSigma_px, 0.0, 20.0)) return fail(fmt::format("PSF sigma must be 0..20 px, got {}", o.psfSigma_px));
+  if (!(o.gain > 0.0 && std::isfinite(o.gain))) return fail(fmt::format("gain must be positive, got {}", o.gain));
+  if (!std::isfinite(o.offset)) return fail(fmt::format("offset must be finite, got {}", o.offset));
+  if (bad(o.gamma, 0.1, 10.0)) return fail(fmt::format("gamma must be 0.1..10, got {}", o.gamma));
+  if (bad(o.vignetting, 0.0, 0.9)) return fail(fmt::format("vignetting must be 0..0.9, got {}", o.vignetting));
+  if (bad(o.collimatorRadiusFraction, 0.0, 1.5)) {
+    return fail(fmt::format("collimator radius fraction must be 0 (none) or up to 1.5, got {}", o.collimatorRadiusFraction));
+  }
+  if (bad(o.boneThreshold_hu, -500.0, 3000.0)) {
+    return fail(fmt::format("bone threshold must be -500..3000 HU, got {}", o.boneThreshold_hu));
+  }
+  return Ok{};
+}
+
+/// Fails unless T's linear part is a proper rotation.
+Status checkRigid(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  if (!T.matrix().allFinite() || (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-6 || R.determinant() < 0.0) {
+    return fail("pose T_world_from_ct is not a rigid transform (its 3x3 part must be a rotation: orthonormal, det +1)");
+  }
+  return Ok{};
+}
+
+/// Builds the spectrum, attenuation table, tracer and implants shared by every view.
+Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) {
+  if (Status valid = validate(options); !valid) return fail(valid.error());
+  auto spectrum = XraySpectrum::create(spectrumOptions(options));
+  if (!spectrum.ok()) return fail(spectrum.error());
+  auto tracer = MaterialPathTracer::create(ct, options.materials);
+  if (!tracer.ok()) return fail(tracer.error());
+  auto implants = ForeignObjectSet::placeNearBone(
+      ct, {options.kwireCount, options.screwCount, options.plate, options.gasPocketCount, options.boneThreshold_hu,
+           options.seed});
+  if (!implants.ok()) return fail(implants.error());
+  Scene scene{std::move(spectrum).value(), {}, std::move(tracer).value(), std::move(implants).value()};
+  for (const SpectrumBin& bin : scene.spectrum.bins()) {
+    MassPaths mu{};
+    for (int m = 0; m < kMaterialCount; ++m) {
+      auto value = MassAttenuationTable::massAttenuation_cm2_per_g(static_cast<Material>(m), bin.energy_keV);
+      if (!value.ok()) return fail(value.error());
+      mu[m] = value.value();
+    }
+    scene.massAttenuation_cm2_per_g.push_back(mu);
+  }
+  return scene;
+}
+
+/// Renders one view of a prepared scene; the pose must already be checked rigid.
+Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
+                                const FluoroscopyOptions& options, std::uint32_t viewSeed) {
+  const CameraIntrinsics& in = camera.intrinsics();
+  if (in.cols <= 0 || in.rows <= 0) return fail("camera has an empty detector; check the view file");
+  std::optional<IntensifierDistortion> distortion;
+  if (options.pincushion != 0.0 || options.sDistortion_deg != 0.0) {
+    auto created = IntensifierDistortion::create(in.cols, in.rows, options.pincushion, options.sDistortion_deg);
+    if (!created.ok()) return fail(created.error());
+    distortion = std::move(created).value();
+  }
+  ForeignObjectSet spheres;
+  if (options.calibrationSpheres) {
+    auto grid = ForeignObjectSet::calibrationGrid(camera, options.sphereSpacing_mm, options.sphereRadius_mm,
+                                                  options.sphereDistanceFromDetector_mm);
+    if (!grid.ok()) return fail(grid.error());
+    spheres = std::move(grid).value();
+  }
+
+  const Eigen::Isometry3d T_ct_from_camera = T_world_from_ct.inverse() * camera.T_world_from_camera();
+  const Eigen::Vector3d source_ct = T_ct_from_camera.translation();
+  const Eigen::Matrix3d R_ct_from_camera = T_ct_from_camera.linear();
+  const Eigen::Matrix3d K = camera.K();
+  const Eigen::Vector2d centre_px(0.5 * (in.cols - 1), 0.5 * (in.rows - 1));
+  const double collimator_px = options.collimatorRadiusFraction * 0.5 * std::min(in.cols, in.rows);
+  const std::size_t binCount = scene.spectrum.bins().size();
+  std::vector<double> photonFraction(binCount), energyWeight(binCount);
+  double energyNorm = 0.0;
+  for (std::size_t b = 0; b < binCount; ++b) {
+    photonFraction[b] = scene.spectrum.bins()[b].photonFraction;
+    energyWeight[b] = photonFraction[b] * scene.spectrum.bins()[b].energy_keV;
+    energyNorm += energyWeight[b];
+  }
+
+  // Pass 1: exact material path integrals and the noiseless signal of every pixel inside the collimator.
+  RenderedView view;
+  view.image = FloatImage::filled(in.cols, in.rows);
+  const std::size_t pixelCount = static_cast<std::size_t>(in.cols) * in.rows;
+  std::vector<MassPaths> pixelPaths(pixelCount);
+  std::vector<std::uint8_t> exposed(pixelCount, 0);
+  const auto transmissions = [&](const MassPaths& paths, std::vector<double>& transmission) {
+    double signal = 0.0;
+    for (std::size_t b = 0; b < binCount; ++b) {
+      double attenuation = 0.0;
+      for (int m = 0; m < kMaterialCount; ++m) attenuation += scene.massAttenuation_cm2_per_g[b][m] * paths[m];
+      transmission[b] = std::exp(-attenuation);
+      signal += energyWeight[b] * transmission[b];
+    }
+    return signal / energyNorm;
+  };
+  tbb::parallel_for(0, in.rows, [&](int row) {
+    std::vector<double> transmission(binCount);
+    for (int col = 0; col < in.cols; ++col) {
+      const std::size_t index = static_cast<std::size_t>(row) * in.cols + col;
+      if (collimator_px > 0.0 && (Eigen::Vector2d(col, row) - centre_px).norm() > collimator_px) continue;
+      const Eigen::Vector3d direction_camera =
+          Eigen::Vector3d((col - K(0, 2)) / K(0, 0), (row - K(1, 2)) / K(1, 1), 1.0).normalized();
+      const Eigen::Vector3d direction_ct = R_ct_from_camera * direction_camera;
+      MassPaths& paths = pixelPaths[index];
+      paths = scene.tracer.trace(source_ct, direction_ct);
+      scene.implants.accumulate(source_ct, direction_ct, paths);
+      spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
+      for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
+      view.image.pixels[index] = static_cast<float>(transmissions(paths, transmission));
+      exposed[index] = 1;
+    }
+  });
+  std::vector<float> field;
+  for (std::size_t index = 0; index < pixelCount; ++index) {
+    if (exposed[index]) field.push_back(view.image.pixels[index]);
+  }
+  if (field.empty()) return fail("the collimator leaves no pixel exposed; raise the collimator radius");
+  view.maxLineIntegral = -std::log(std::max(1e-30, double(*std::min_element(field.begin(), field.end()))));
+  view.referenceSignal = 1.0;
+  if (options.automaticExposure) {
+    const auto reference = field.begin() + static_cast<std::ptrdiff_t>(0.99 * double(field.size() - 1));
+    std::nth_element(field.begin(), reference, field.end());
+    if (!(*reference > 1e-30f)) return fail("no X-ray reaches the detector through this CT; check the pose and views");
+    view.referenceSignal = *reference;
+  }
+
+  // Pass 2: exposure scaling and Poisson quantum noise per energy bin.
+  const double photons = options.photonsPerPixel / view.referenceSignal;
+  tbb::parallel_for(0, in.rows, [&](int row) {
+    SeededRandom random(SeededRandom::streamSeed(viewSeed, static_cast<std::uint32_t>(row)));
+    std::vector<double> transmission(binCount);
+    for (int col = 0; col < in.cols; ++col) {
+      const std::size_t index = static_cast<std::size_t>(row) * in.cols + col;
+      if (!exposed[index]) continue;
+      float& out = view.image.pixels[index];
+      if (options.photonsPerPixel == 0.0) {
+        out = static_cast<float>(out / view.referenceSignal);
+        continue;
+      }
+      transmissions(pixelPaths[index], transmission);
+      double energy = 0.0;
+      for (std::size_t b = 0; b < binCount; ++b) {
+        energy += static_cast<double>(random.poisson(photons * photonFraction[b] * transmission[b])) *
+                  scene.spectrum.bins()[b].energy_keV;
+      }
+      out = static_cast<float>(energy / (options.photonsPerPixel * energyNorm));
+    }
+  });
+
+  if (options.psfSigma_px > 0.0) {
+    try {
+      cv::Mat image(in.rows, in.cols, CV_32F, view.image.pixels.data());
+      cv::GaussianBlur(image, image, cv::Size(0, 0), options.psfSigma_px, options.psfSigma_px, cv::BORDER_REPLICATE);
+    } catch (const cv::Exception& e) {
+      return fail(fmt::format("point-spread blur failed: {}", e.what()));
+    }
+  }
+  if (distortion) {
+    auto warped = distortion->warp(view.image);
+    if (!warped.ok()) return fail(warped.error());
+    view.image = std::move(warped).value();
+    view.field = distortion->field();
+  }
+  const double halfDiagonal2 = centre_px.squaredNorm();
+  tbb::parallel_for(0, in.rows, [&](int row) {
+    for (int col = 0; col < in.cols; ++col) {
+      const double vignette =
+          1.0 - options.vignetting * (Eigen::Vector2d(col, row) - centre_px).squaredNorm() / halfDiagonal2;
+      float& value = view.image.at(col, row);
+      value = static_cast<float>(options.offset +
+                                 options.gain * std::pow(std::max(0.0, vignette * double(value)), options.gamma));
+    }
+  });
+
+  for (const ForeignObject& sphere : spheres.objects()) {
+    const Eigen::Vector3d uvw = K * sphere.a_mm;
+    Eigen::Vector2d centre = uvw.head<2>() / uvw.z();
+    const double radius_px = sphere.radius_mm * in.sourceToDetector_mm / sphere.a_mm.z() / in.pixelSpacing_mm.minCoeff();
+    double radius = radius_px;
+    if (distortion) {
+      const Eigen::Vector2d observed = distortion->distort(centre);
+      radius = std::max((distortion->distort(centre + Eigen::Vector2d(radius_px, 0)) - observed).norm(),
+                        (distortion->distort(centre + Eigen::Vector2d(0, radius_px)) - observed).norm());
+      centre = observed;
+    }
+    view.spheres.push_back({centre, radius});
+  }
+  return view;
+}
+
+/// Every option, for simulation.json.
+nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
+  nlohmann::ordered_json j;
+  j["tube_voltage_kvp"] = o.tubeVoltage_kvp;
+  j["filtration_mm_al"] = o.filtration_mmAl;
+  j["spectrum_bin_width_kev"] = o.spectrumBinWidth_keV;
+  j["monochromatic_kev"] = o.monochromatic_keV;
+  j["hu_air_below"] = o.materials.airBelow_hu;
+  j["hu_bone_from"] = o.materials.boneFrom_hu;
+  j["hu_cortical_bone"] = o.materials.corticalBone_hu;
+  j["hu_metal_from"] = o.materials.metalFrom_hu;
+  j["automatic_exposure"] = o.automaticExposure;
+  j["photons_per_pixel"] = o.photonsPerPixel;
+  j["psf_sigma_px"] = o.psfSigma_px;
+  j["gain"] = o.gain;
+  j["offset"] = o.offset;
+  j["gamma"] = o.gamma;
+  j["pincushion"] = o.pincushion;
+  j["s_distortion_deg"] = o.sDistortion_deg;
+  j["vignetting"] = o.vignetting;
+  j["collimator_radius_fraction"] = o.collimatorRadiusFraction;
+  j["kwires"] = o.kwireCount;
+  j["screws"] = o.screwCount;
+  j["plate"] = o.plate;
+  j["gas_pockets"] = o.gasPocketCount;
+  j["calibration_spheres"] = o.calibrationSpheres;
+  j["sphere_spacing_mm"] = o.sphereSpacing_mm;
+  j["sphere_radius_mm"] = o.sphereRadius_mm;
+  j["sphere_distance_from_detector_mm"] = o.sphereDistanceFromDetector_mm;
+  j["bone_threshold_hu"] = o.boneThreshold_hu;
+  j["seed"] = o.seed;
+  return j;
+}
+
+}  // namespace
+
+Result<FloatImage> FluoroscopySimulator::render(const Volume& ct, const Camera& camera,
+                                                const Eigen::Isometry3d& T_world_from_ct,
+                                                const FluoroscopyOptions& options, std::uint32_t viewSeed) {
+  if (Status rigid = checkRigid(T_world_from_ct); !rigid) return fail(rigid.error());
+  auto scene = prepareScene(ct, options);
+  if (!scene.ok()) return fail(scene.error());
+  auto view = renderView(scene.value(), camera, T_world_from_ct, options, viewSeed);
+  if (!view.ok()) return fail(view.error());
+  return std::move(view.value().image);
+}
+
+Result<SimulatedCase> FluoroscopySimulator::writeCase(const Volume& ct, const std::vector<ViewSpec>& views,
+                                                      const Eigen::Isometry3d& T_world_from_ct,
+                                                      const FluoroscopyOptions& options,
+                                                      const std::filesystem::path& outDir, const std::string& ctSource) {
+  if (Status checked = SimulatedCaseWriter::checkViews(views); !checked) return fail(checked.error());
+  if (Status rigid = checkRigid(T_world_from_ct); !rigid) return fail(rigid.error());
+  if (outDir.empty()) return fail("output folder is empty");
+  auto scene = prepareScene(ct, options);
+  if (!scene.ok()) return fail(scene.error());
+
+  // Compute every image first, so that a failure writes nothing.
+  std::vector<ViewSpec> written = views;
+  std::vector<FloatImage> images;
+  std::vector<SimulatedExtraImage> extras;
+  std::vector<double> maxLineIntegral;
+  nlohmann::ordered_json perView = nlohmann::ordered_json::array();
+  for (std::size_t n = 0; n < views.size(); ++n) {
+    const std::uint32_t viewSeed = options.seed + static_cast<std::uint32_t>(n);
+    auto view = renderView(scene.value(), views[n].camera, T_world_from_ct, options, viewSeed);
+    if (!view.ok()) return fail(fmt::format("view '{}': {}", views[n].name, view.error()));
+    nlohmann::ordered_json entry{{"name", views[n].name}, {"image", views[n].name + ".png"}, {"seed", viewSeed},
+                                 {"max_line_integral", view.value().maxLineIntegral},
+                                 {"exposure_reference_signal", view.value().referenceSignal},
+                                 {"calibration_spheres", view.value().spheres.size()}};
+    if (view.value().field) {
+      const Eigen::Vector2d spacing = views[n].camera.intrinsics().pixelSpacing_mm;
+      extras.push_back({views[n].name + "_distortion_dcol.nrrd", view.value().field->dcol_px, spacing});
+      extras.push_back({views[n].name + "_distortion_drow.nrrd", view.value().field->drow_px, spacing});
+      entry["distortion_field"] = {views[n].name + "_distortion_dcol.nrrd", views[n].name + "_distortion_drow.nrrd"};
+    }
+    if (options.calibrationSpheres) {
+      written[n].calibrationSpheres = view.value().spheres;
+    }
+    perView.push_back(std::move(entry));
+    maxLineIntegral.push_back(view.value().maxLineIntegral);
+    images.push_back(std::move(view.value().image));
+  }
+
+  nlohmann::ordered_json parameters;
+  parameters["model"] = "physical";
+  parameters["ct"] = ctSource;
+  parameters["options"] = optionsJson(options);
+  parameters["spectrum"] = scene.value().spectrum.describe();
+  nlohmann::ordered_json bins = nlohmann::ordered_json::array();
+  for (std::size_t b = 0; b < scene.value().spectrum.bins().size(); ++b) {
+    const SpectrumBin& bin = scene.value().spectrum.bins()[b];
+    nlohmann::ordered_json mu;
+    for (int m = 0; m < kMaterialCount; ++m) {
+      mu[std::string(MassAttenuationTable::name(static_cast<Material>(m)))] = scene.value().massAttenuation_cm2_per_g[b][m];
+    }
+    bins.push_back({{"energy_kev", bin.energy_keV}, {"photon_fraction", bin.photonFraction}, {"mu_over_rho_cm2_per_g", mu}});
+  }
+  parameters["spectrum_bins"] = bins;
+  parameters["attenuation_source"] = "NIST XCOM / NISTIR 5632 (Hubbell & Seltzer), log-log interpolated";
+  parameters["implants_ct_lps_mm"] = scene.value().implants.toJson();
+  parameters["distortion_model"] =
+      "observed = c + Rot(s * rho^2) * (u - c) * (1 + k * rho^2), rho = |u - c| / (min(cols, rows) / 2), c = detector "
+      "centre; field files hold observed - ideal per ideal pixel";
+  parameters["png"] = "16-bit grey, value = offset + gain * (vignetting * signal / reference)^gamma rounded and clamped to "
+                      "0..65535, MONOCHROME2 (bright = more signal)";
+  parameters["images"] = perView;
+  auto result = SimulatedCaseWriter::write(written, images, extras, T_world_from_ct, parameters, outDir);
+  if (!result.ok()) return fail(result.error());
+  result.value().maxLineIntegral = std::move(maxLineIntegral);
+  return result;
+}
+
+}  // namespace fct

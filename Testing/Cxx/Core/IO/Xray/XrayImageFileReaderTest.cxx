@@ -1,0 +1,102 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "IO/Xray/XrayImageFileReader.h"
+#include "TestSupport.h"
+
+using fct::XrayImageFileReader;
+
+namespace {
+
+/// A cols x rows gradient of the given OpenCV type with values spread over `maxValue`.
+cv::Mat gradient(int cols, int rows, int type, double maxValue) {
+  cv::Mat m(rows, cols, type);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const double v = maxValue * (r * cols + c) / (rows * cols - 1);
+      if (type == CV_8U) m.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(v);
+      else m.at<std::uint16_t>(r, c) = static_cast<std::uint16_t>(v);
+    }
+  }
+  return m;
+}
+
+void expectSamePixels(const fct::XrayImage& image, const cv::Mat& expected) {
+  ASSERT_EQ(image.cols, expected.cols);
+  ASSERT_EQ(image.rows, expected.rows);
+  cv::Mat asFloat;
+  expected.convertTo(asFloat, CV_32F);
+  for (int r = 0; r < expected.rows; ++r) {
+    for (int c = 0; c < expected.cols; ++c) ASSERT_EQ(image.at(c, r), asFloat.at<float>(r, c)) << c << "," << r;
+  }
+}
+
+}  // namespace
+
+TEST(XrayImageFileReader, RoundTripsEightBitPng) {
+  const cv::Mat original = gradient(37, 21, CV_8U, 255);
+  const auto path = fct::test::scratchDir() / "grey8.png";
+  ASSERT_TRUE(cv::imwrite(path.string(), original));
+  auto image = XrayImageFileReader::read(path);
+  ASSERT_TRUE(image) << image.error();
+  EXPECT_EQ(image.value().modality, "PNG");
+  EXPECT_EQ(image.value().bitsStored, 8);
+  EXPECT_EQ(image.value().photometric, "MONOCHROME2");
+  EXPECT_FALSE(image.value().camera.has_value());
+  EXPECT_TRUE(image.warnings().empty());
+  expectSamePixels(image.value(), original);
+}
+
+TEST(XrayImageFileReader, KeepsSixteenBitValuesInTiffAndPng) {
+  const cv::Mat original = gradient(40, 30, CV_16U, 65535);
+  const auto dir = fct::test::scratchDir();
+  for (const char* name : {"grey16.tif", "grey16.png"}) {
+    ASSERT_TRUE(cv::imwrite((dir / name).string(), original));
+    auto image = XrayImageFileReader::read(dir / name);
+    ASSERT_TRUE(image) << image.error();
+    EXPECT_EQ(image.value().bitsStored, 16) << name;
+    EXPECT_FLOAT_EQ(image.value().at(39, 29), 65535.0f) << name;  // above 255: 16 bits survived
+    expectSamePixels(image.value(), original);
+  }
+  EXPECT_EQ(XrayImageFileReader::read(dir / "grey16.tif").value().modality, "TIFF");
+}
+
+TEST(XrayImageFileReader, ConvertsColourToGreyWithWarning) {
+  cv::Mat colour(8, 8, CV_8UC3, cv::Scalar(10, 200, 30));  // B, G, R
+  const auto dir = fct::test::scratchDir();
+  ASSERT_TRUE(cv::imwrite((dir / "colour.png").string(), colour));
+  auto image = XrayImageFileReader::read(dir / "colour.png");
+  ASSERT_TRUE(image) << image.error();
+  ASSERT_EQ(image.warnings().size(), 1u);
+  EXPECT_NE(image.warnings()[0].find("colour"), std::string::npos);
+  EXPECT_NEAR(image.value().at(3, 3), 0.299 * 30 + 0.587 * 200 + 0.114 * 10, 1.0);
+
+  cv::Mat greyAsRgb(8, 8, CV_8UC3, cv::Scalar(77, 77, 77));
+  ASSERT_TRUE(cv::imwrite((dir / "greyrgb.png").string(), greyAsRgb));
+  auto grey = XrayImageFileReader::read(dir / "greyrgb.png");
+  ASSERT_TRUE(grey) << grey.error();
+  EXPECT_TRUE(grey.warnings().empty());
+  EXPECT_EQ(grey.value().at(0, 0), 77.0f);
+}
+
+TEST(XrayImageFileReader, RejectsUnknownExtensionCorruptAndMissingFiles) {
+  const auto dir = fct::test::scratchDir();
+  auto jpeg = XrayImageFileReader::read(dir / "x.jpg");
+  ASSERT_FALSE(jpeg);
+  EXPECT_NE(jpeg.error().find("not a PNG or TIFF"), std::string::npos) << jpeg.error();
+
+  EXPECT_NE(XrayImageFileReader::read(dir / "absent.png").error().find("does not exist"), std::string::npos);
+
+  std::ofstream(dir / "broken.tif") << "II*\0garbage that is not a TIFF directory";
+  auto broken = XrayImageFileReader::read(dir / "broken.tif");
+  ASSERT_FALSE(broken);
+  EXPECT_NE(broken.error().find("cannot"), std::string::npos) << broken.error();
+
+  ASSERT_TRUE(cv::imwrite((dir / "signed.tif").string(), cv::Mat(4, 4, CV_16S, cv::Scalar(-5))));
+  auto signedImage = XrayImageFileReader::read(dir / "signed.tif");
+  ASSERT_FALSE(signedImage);
+  EXPECT_NE(signedImage.error().find("unsupported pixel type"), std::string::npos) << signedImage.error();
+}

@@ -1,0 +1,122 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "Drr/DrrVolume.h"
+
+namespace {
+
+fct::Volume fourVoxelCt() {
+  fct::Volume ct = fct::Volume::create({4, 1, 1}, {0.5, 0.7, 2.0}, {10, 20, 30}).value();
+  ct.voxels() = {-1200.0f, -1000.0f, 0.0f, 1000.0f};
+  return ct;
+}
+
+}  // namespace
+
+TEST(DrrVolume, ConvertsHuToAttenuationWithAirClampedToZero) {
+  const auto volume = fct::DrrVolume::create(fourVoxelCt());
+  ASSERT_TRUE(volume.ok()) << volume.error();
+  const double mu = fct::DrrValueOptions::kWaterAttenuationAt60keV_per_mm;
+  const std::vector<float>& v = volume.value().values().voxels();
+  EXPECT_EQ(v[0], 0.0f);
+  EXPECT_EQ(v[1], 0.0f);
+  EXPECT_NEAR(v[2], mu, 1e-7);
+  EXPECT_NEAR(v[3], 2.0 * mu, 1e-7);
+  EXPECT_EQ(volume.value().options().kind, fct::DrrValueKind::Attenuation);
+}
+
+TEST(DrrVolume, RawValuesAndGeometryAreThoseOfTheCt) {
+  const fct::Volume ct = fourVoxelCt();
+  fct::DrrValueOptions options;
+  options.kind = fct::DrrValueKind::Raw;
+  const auto volume = fct::DrrVolume::create(ct, options);
+  ASSERT_TRUE(volume.ok()) << volume.error();
+  EXPECT_EQ(volume.value().values().voxels(), ct.voxels());
+  const Eigen::Vector3d p_ct_mm(11.3, 19.0, 33.0);
+  EXPECT_NEAR((volume.value().T_ct_from_ijk() * (volume.value().T_ijk_from_ct() * p_ct_mm) - p_ct_mm).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((volume.value().T_ijk_from_ct() * p_ct_mm - ct.ijkFromLps(p_ct_mm)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(volume.value().boxMax_ijk(), Eigen::Vector3d(3.5, 0.5, 0.5));
+}
+
+TEST(DrrVolume, ContentBoxHoldsExactlyTheNonZeroVoxels) {
+  fct::Volume ct = fct::Volume::create({10, 8, 6}, {1.0, 1.0, 1.0}, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                       -1000.0f)
+                       .value();
+  ct.at(2, 5, 1) = 40.0f;
+  ct.at(7, 3, 4) = 200.0f;
+  const auto volume = fct::DrrVolume::create(ct);  // attenuation: air -> 0
+  ASSERT_TRUE(volume.ok()) << volume.error();
+  EXPECT_TRUE(volume.value().hasContent());
+  EXPECT_EQ(volume.value().contentBoxMin_ijk(), Eigen::Vector3d(1.5, 2.5, 0.5));
+  EXPECT_EQ(volume.value().contentBoxMax_ijk(), Eigen::Vector3d(7.5, 5.5, 4.5));
+
+  fct::DrrValueOptions raw;
+  raw.kind = fct::DrrValueKind::Raw;  // raw: air is -1000, so everything is content
+  const auto rawVolume = fct::DrrVolume::create(ct, raw);
+  EXPECT_EQ(rawVolume.value().contentBoxMin_ijk(), rawVolume.value().boxMin_ijk());
+  EXPECT_EQ(rawVolume.value().contentBoxMax_ijk(), rawVolume.value().boxMax_ijk());
+
+  ct.voxels().assign(ct.voxelCount(), -1024.0f);
+  EXPECT_FALSE(fct::DrrVolume::create(ct).value().hasContent());
+}
+
+TEST(DrrVolume, RejectsEmptyCtNonFiniteVoxelsAndBadWaterAttenuation) {
+  EXPECT_FALSE(fct::DrrVolume::create(fct::Volume()).ok());
+  fct::Volume ct = fourVoxelCt();
+  ct.voxels()[2] = std::numeric_limits<float>::quiet_NaN();
+  const auto nan = fct::DrrVolume::create(ct);
+  ASSERT_FALSE(nan.ok());
+  EXPECT_NE(nan.error().find("1 voxels that are NaN"), std::string::npos) << nan.error();
+  fct::DrrValueOptions options;
+  options.waterAttenuation_per_mm = 0.0;
+  EXPECT_FALSE(fct::DrrVolume::create(fourVoxelCt(), options).ok());
+}
+
+TEST(DrrVolume, CoarsenedAveragesBlocksWithAirBeyondTheEdgeAndKeepsTheFrame) {
+  Eigen::Matrix3d direction;
+  direction << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // a rotation: i along +P, j along -L
+  fct::Volume ct = fct::Volume::create({5, 4, 3}, {0.5, 0.7, 2.0}, {10, 20, 30}, direction).value();
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 5; ++i) ct.at(i, j, k) = static_cast<float>(i + 10 * j + 100 * k);
+  fct::DrrValueOptions raw;
+  raw.kind = fct::DrrValueKind::Raw;
+  const fct::DrrVolume fine = fct::DrrVolume::create(ct, raw).value();
+  const auto coarse = fine.coarsened({2, 2, 1});
+  ASSERT_TRUE(coarse.ok()) << coarse.error();
+  const fct::Volume& c = coarse.value().values();
+  EXPECT_EQ(c.dims(), Eigen::Vector3i(3, 2, 3)) << "5 voxels in blocks of 2 round up to 3";
+  EXPECT_EQ(c.spacing_mm(), Eigen::Vector3d(1.0, 1.4, 2.0));
+  EXPECT_FLOAT_EQ(c.at(0, 0, 0), (0 + 1 + 10 + 11) / 4.0f);
+  EXPECT_FLOAT_EQ(c.at(1, 1, 2), (222 + 223 + 232 + 233) / 4.0f);
+  EXPECT_FLOAT_EQ(c.at(2, 0, 1), (104 + 114) / 4.0f) << "the missing column counts as 0";
+  // A coarse voxel's centre is the centroid of its block's voxel centres, in the same CT frame.
+  EXPECT_NEAR((c.lpsFromIjk({1, 1, 2}) - ct.lpsFromIjk({2.5, 2.5, 2.0})).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((coarse.value().T_ct_from_ijk() * Eigen::Vector3d(1, 1, 2) - ct.lpsFromIjk({2.5, 2.5, 2.0})).norm(), 0.0,
+              1e-12);
+  EXPECT_EQ(coarse.value().options().kind, fct::DrrValueKind::Raw);
+  EXPECT_FALSE(fine.coarsened({0, 1, 1}).ok());
+  EXPECT_NE(fine.coarsened({1, 1, -2}).error().find("at least 1"), std::string::npos);
+}
+
+TEST(DrrVolume, CoarsenedKeepsTheTotalAttenuation) {
+  fct::Volume ct = fct::Volume::create({12, 9, 8}, {0.45, 0.45, 1.0}).value();
+  for (std::size_t n = 0; n < ct.voxels().size(); ++n) ct.voxels()[n] = static_cast<float>((n * 7919) % 2400) - 1000.0f;
+  const fct::DrrVolume fine = fct::DrrVolume::create(ct).value();
+  const fct::DrrVolume coarse = fine.coarsened({4, 3, 2}).value();
+  double fineSum = 0.0, coarseSum = 0.0;
+  for (const float v : fine.values().voxels()) fineSum += v;
+  for (const float v : coarse.values().voxels()) coarseSum += v;
+  EXPECT_NEAR(coarseSum * 24.0, fineSum, 1e-5 * fineSum) << "attenuation x volume is kept";
+}
+
+TEST(DrrVolume, ParsesValueKindNames) {
+  for (const auto kind : {fct::DrrValueKind::Attenuation, fct::DrrValueKind::Raw}) {
+    const auto parsed = fct::DrrVolume::parseValueKind(fct::DrrVolume::valueKindName(kind));
+    ASSERT_TRUE(parsed.ok());
+    EXPECT_EQ(parsed.value(), kind);
+  }
+  EXPECT_FALSE(fct::DrrVolume::parseValueKind("hu").ok());
+}

@@ -1,0 +1,57 @@
+// LineChart: a chart has the requested size, a white background, black axes and its series' colours; bad specs fail.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "Evaluation/LineChart.h"
+
+namespace {
+
+bool hasColour(const fct::RgbImage& image, const std::array<std::uint8_t, 3>& rgb) {
+  for (int row = 0; row < image.rows; ++row)
+    for (int col = 0; col < image.cols; ++col)
+      if (image.at(col, row) == rgb) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(LineChart, DrawsAxesAndEverySeriesInItsColour) {
+  fct::ChartSpec spec;
+  spec.title = "Cumulative failure";
+  spec.xLabel = "initial sTRE (mm)";
+  spec.yLabel = "failure (%)";
+  spec.series.push_back({"ncc", {10, 20, 30}, {0, 10, 40}, true});
+  spec.series.push_back({"vlnc", {10, 20, 30}, {0, NAN, 20}, false});
+  spec.width_px = 640;
+  spec.height_px = 400;
+  const auto image = fct::LineChart::draw(spec);
+  ASSERT_TRUE(image.ok()) << image.error();
+  EXPECT_EQ(image.value().cols, 640);
+  EXPECT_EQ(image.value().rows, 400);
+  EXPECT_EQ(image.value().at(2, 2), (std::array<std::uint8_t, 3>{255, 255, 255}));
+  EXPECT_TRUE(hasColour(image.value(), {0, 0, 0}));
+  EXPECT_TRUE(hasColour(image.value(), fct::LineChart::seriesColour(0)));
+  EXPECT_TRUE(hasColour(image.value(), fct::LineChart::seriesColour(1)));
+}
+
+TEST(LineChart, CategoryAxisAcceptsIndicesOfItsCategories) {
+  fct::ChartSpec spec;
+  spec.categories = {"ideal", "realistic", "bad"};
+  spec.series.push_back({"pelvis", {0, 1, 2}, {0.2, 0.3, 0.9}, false});
+  EXPECT_TRUE(fct::LineChart::draw(spec).ok());
+  spec.series.front().x = {0, 1, 3};
+  EXPECT_FALSE(fct::LineChart::draw(spec).ok());
+}
+
+TEST(LineChart, BadSpecsAreRejected) {
+  fct::ChartSpec spec;
+  EXPECT_FALSE(fct::LineChart::draw(spec).ok());  // no series
+  spec.series.push_back({"a", {1, 2}, {1}, true});
+  const auto mismatched = fct::LineChart::draw(spec);
+  ASSERT_FALSE(mismatched.ok());
+  EXPECT_NE(mismatched.error().find("2 x values but 1 y values"), std::string::npos) << mismatched.error();
+  spec.series.front().y = {1, 2};
+  spec.width_px = 100;
+  EXPECT_FALSE(fct::LineChart::draw(spec).ok());
+}

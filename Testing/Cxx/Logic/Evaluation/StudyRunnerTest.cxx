@@ -1,0 +1,87 @@
+// StudyRunner and StudyXraySource: schedule variants, the registration CT per scenario, and bad study input (checked
+// before any simulation or registration).
+#include <gtest/gtest.h>
+
+#include "Evaluation/StudyCatalog.h"
+#include "Evaluation/StudyRunner.h"
+#include "Evaluation/StudyXraySource.h"
+#include "TestSupport.h"
+
+namespace {
+
+fct::Volume tinyCt(double sliceSpacing_mm) {
+  fct::Volume ct = fct::Volume::create(Eigen::Vector3i(12, 12, 12), Eigen::Vector3d(1.0, 1.0, sliceSpacing_mm)).value();
+  for (int k = 3; k < 9; ++k)
+    for (int j = 3; j < 9; ++j)
+      for (int i = 3; i < 9; ++i) ct.at(i, j, k) = 1200.0f;
+  return ct;
+}
+
+}  // namespace
+
+TEST(StudyRunner, ScheduleForMeasuresKeepsOrReplacesEveryStageMetric) {
+  const fct::RegistrationSchedule base = fct::RegistrationSchedule::builtin("fast").value();
+  const fct::RegistrationSchedule both = fct::StudyRunner::scheduleFor(base, fct::StudyMeasures::Both);
+  ASSERT_EQ(both.stages.size(), base.stages.size());
+  for (std::size_t s = 0; s < base.stages.size(); ++s) EXPECT_EQ(both.stages[s].metric, base.stages[s].metric);
+  for (const auto& [measures, metric] : {std::pair{fct::StudyMeasures::NccOnly, fct::SimilarityMetric::Ncc},
+                                         std::pair{fct::StudyMeasures::VlncOnly, fct::SimilarityMetric::Vlnc}}) {
+    const fct::RegistrationSchedule changed = fct::StudyRunner::scheduleFor(base, measures);
+    for (const fct::RegistrationStage& stage : changed.stages) EXPECT_EQ(stage.metric, metric);
+    EXPECT_EQ(changed.stages.front().pixels.kind, base.stages.front().pixels.kind);
+  }
+}
+
+TEST(StudyRunner, BadStudiesFailBeforeAnyTrial) {
+  auto study = fct::StudyCatalog::define("table2", true, {"phantom"}).value();
+  std::vector<fct::StudyCt> cts{{"other", tinyCt(1.0)}};
+  auto store = fct::TrialStore::open(fct::test::scratchDir() / "trials.csv").value();
+  const auto unknownCt = fct::StudyRunner::run(study, cts, store);
+  ASSERT_FALSE(unknownCt.ok());
+  EXPECT_NE(unknownCt.error().find("no CT labelled 'phantom'"), std::string::npos) << unknownCt.error();
+
+  cts.front().label = "phantom";
+  fct::StudyRunOptions options;
+  options.jobs = 0;
+  EXPECT_FALSE(fct::StudyRunner::run(study, cts, store, options).ok());
+  study.conditions.front().viewCount = 6;
+  const auto sixViews = fct::StudyRunner::run(study, cts, store);
+  ASSERT_FALSE(sixViews.ok());
+  EXPECT_NE(sixViews.error().find("6 views"), std::string::npos) << sixViews.error();
+  EXPECT_TRUE(store.records().empty());
+}
+
+TEST(StudyXraySource, RegistrationCtIsTheOriginalUnlessTheScenarioAsksForCoarserSlices) {
+  const fct::Volume fine = tinyCt(1.0);
+  const auto same = fct::StudyXraySource::registrationCt(fine, 0.0);
+  ASSERT_TRUE(same.ok()) << same.error();
+  EXPECT_EQ(same.value().dims(), fine.dims());
+  const auto coarse = fct::StudyXraySource::registrationCt(fine, 2.4);
+  ASSERT_TRUE(coarse.ok()) << coarse.error();
+  EXPECT_DOUBLE_EQ(coarse.value().spacing_mm().z(), 2.4);
+  EXPECT_LT(coarse.value().dims().z(), fine.dims().z());
+
+  const fct::Volume thick = tinyCt(3.0);
+  EXPECT_EQ(fct::StudyXraySource::effectiveSliceSpacing_mm(thick, 2.4), 0.0);
+  EXPECT_EQ(fct::StudyXraySource::registrationCt(thick, 2.4).value().dims(), thick.dims());
+  EXPECT_FALSE(fct::StudyXraySource::registrationCt(fine, -1.0).ok());
+}
+
+TEST(StudyRunner, NotesSayWhenAScenarioKeepsTheOriginalCt) {
+  const auto study = fct::StudyCatalog::define("table2", false, {"pelvis"}).value();
+  const std::vector<std::string> notes = fct::StudyRunner::notes(study, {{"pelvis", tinyCt(3.0)}});
+  ASSERT_EQ(notes.size(), 3u);  // X-ray model, DRR method, 'realistic' (2.4 mm < 3 mm); 'bad' (4.2 mm) is resampled
+  EXPECT_EQ(notes[0].rfind("X-rays: FluoroscopySimulator", 0), 0u);
+  EXPECT_EQ(notes[1], "DRRs: siddon method");
+  EXPECT_NE(notes[2].find("scenario 'realistic'"), std::string::npos) << notes[2];
+}
+
+TEST(StudyRunner, ResolveSliceSpacingsGivesTheSpacingActuallyUsed) {
+  auto study = fct::StudyCatalog::define("table2", false, {"pelvis", "missing"}).value();
+  fct::StudyRunner::resolveSliceSpacings(study, {{"pelvis", tinyCt(3.0)}});
+  ASSERT_EQ(study.conditions.size(), 6u);  // pelvis ideal, realistic, bad; missing ideal, realistic, bad
+  EXPECT_DOUBLE_EQ(study.conditions[0].usedSliceSpacing_mm, 3.0);  // ideal: the original
+  EXPECT_DOUBLE_EQ(study.conditions[1].usedSliceSpacing_mm, 3.0);  // realistic asks 2.4 mm: the original is coarser
+  EXPECT_DOUBLE_EQ(study.conditions[2].usedSliceSpacing_mm, 4.2);  // bad: resampled
+  EXPECT_EQ(study.conditions[3].usedSliceSpacing_mm, 0.0);         // no such CT: left unresolved
+}

@@ -1,0 +1,153 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "Base/JsonDocument.h"
+#include "Registration/RegistrationSchedule.h"
+#include "TestSupport.h"
+
+using fct::RegistrationSchedule;
+
+TEST(RegistrationSchedule, PaperPresetHasThePapersThreeStages) {
+  auto paper = RegistrationSchedule::builtin("paper");
+  ASSERT_TRUE(paper.ok()) << paper.error();
+  const auto& s = paper.value().stages;
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_EQ(s[0].metric, fct::SimilarityMetric::Ncc);
+  EXPECT_EQ(s[0].level, 2);
+  EXPECT_EQ(s[0].pixels.kind, fct::PixelSetKind::WholeImage);
+  EXPECT_EQ(s[0].search, fct::SearchStrategy::Genetic);
+  EXPECT_EQ(s[0].genetic.randomGuesses, 4);
+  EXPECT_EQ(s[1].metric, fct::SimilarityMetric::Vlnc);
+  EXPECT_EQ(s[1].level, 2);
+  EXPECT_EQ(s[1].pixels.kind, fct::PixelSetKind::Rois);
+  EXPECT_EQ(s[1].pixels.windowSize, 7);
+  EXPECT_EQ(s[1].search, fct::SearchStrategy::Genetic);
+  EXPECT_EQ(s[2].metric, fct::SimilarityMetric::Vlnc);
+  EXPECT_EQ(s[2].level, 0);
+  EXPECT_EQ(s[2].pixels.kind, fct::PixelSetKind::Rois);
+  EXPECT_EQ(s[2].search, fct::SearchStrategy::Local);
+  EXPECT_EQ(RegistrationSchedule::builtinNames(), (std::vector<std::string>{"fast", "paper"}));
+}
+
+TEST(RegistrationSchedule, JsonRoundTripGivesTheSameSchedule) {
+  for (const std::string& name : RegistrationSchedule::builtinNames()) {
+    SCOPED_TRACE(name);
+    const auto original = RegistrationSchedule::builtin(name).value().withSeed(42);
+    const auto json = original.toJson();
+    auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
+    ASSERT_TRUE(again.ok()) << again.error();
+    EXPECT_EQ(again.value().toJson(), json);
+    EXPECT_EQ(again.value().stages[0].genetic.seed, 42u);
+    EXPECT_EQ(again.value().stages[1].cmaes.seed, 43u);
+  }
+}
+
+TEST(RegistrationSchedule, ReadsAUserFileAndResolvesNames) {
+  const auto dir = fct::test::scratchDir();
+  const auto path = dir / "mine.json";
+  std::ofstream(path) << R"({"name": "mine", "stages": [
+      {"name": "only", "metric": "gc", "level": 1, "pixels": {"set": "whole"},
+       "search": {"strategy": "cmaes", "max_evaluations": 50, "cmaes": {"sigma": 2}}}]})";
+  auto mine = RegistrationSchedule::resolve(path.string());
+  ASSERT_TRUE(mine.ok()) << mine.error();
+  EXPECT_EQ(mine.value().name, "mine");
+  ASSERT_EQ(mine.value().stages.size(), 1u);
+  EXPECT_EQ(mine.value().stages[0].metric, fct::SimilarityMetric::GradientCorrelation);
+  EXPECT_EQ(mine.value().stages[0].search, fct::SearchStrategy::CmaEs);
+  EXPECT_EQ(mine.value().stages[0].cmaes.initialSigma, 2.0);
+  EXPECT_EQ(mine.value().stages[0].maxEvaluations, 50);
+  auto fast = RegistrationSchedule::resolve("fast");
+  ASSERT_TRUE(fast.ok()) << fast.error();
+  EXPECT_EQ(fast.value().name, "fast");
+}
+
+TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
+  auto parse = [](const std::string& text) {
+    return RegistrationSchedule::fromJson(nlohmann::json::parse(text), "test.json");
+  };
+  const std::string stageHead = R"({"name": "x", "stages": [{"name": "s", )";
+  const std::string search = R"("search": {"strategy": "local", "max_evaluations": 10}})";
+  struct Case {
+    std::string text;
+    std::string expected;
+  };
+  const std::vector<Case> cases{
+      {R"({"name": "x", "stages": []})", "stages"},
+      {R"({"name": "x"})", "stages"},
+      {stageHead + R"("metric": "mi", "level": 0, "pixels": {"set": "whole"}, )" + search + "]}", "metric"},
+      {stageHead + R"("metric": "ncc", "level": 9, "pixels": {"set": "whole"}, )" + search + "]}", "level"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "rois", "fraction": 0}, )" + search + "]}",
+       "fraction"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "rois", "window": 1}, )" + search + "]}",
+       "window"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "all"}, )" + search + "]}", "set"},
+      {stageHead + R"("metric": "ncc", "level": 0, "exact_drr": "yes", "pixels": {"set": "whole"}, )" + search + "]}",
+       "exact_drr"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}})" + "]}", "search"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "local", )" +
+           R"("max_evaluations": 10, "simplex": {"tolerance": -1}}}]})",
+       "tolerance"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    auto schedule = parse(c.text);
+    ASSERT_FALSE(schedule.ok());
+    EXPECT_NE(schedule.error().find(c.expected), std::string::npos) << schedule.error();
+    EXPECT_NE(schedule.error().find("test.json"), std::string::npos) << schedule.error();
+  }
+  auto unknown = RegistrationSchedule::resolve("fastest");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().find("fast, paper"), std::string::npos) << unknown.error();
+}
+
+TEST(RegistrationSchedule, AblationTurnsOneTechniqueOffAtATime) {
+  const auto paper = RegistrationSchedule::builtin("paper").value();
+  EXPECT_EQ(paper.withAblation({}).toJson(), paper.toJson()) << "no switch: unchanged";
+  fct::RegistrationAblation cmaes;
+  cmaes.cmaesForGenetic = true;
+  const auto withCmaes = paper.withAblation(cmaes);
+  EXPECT_EQ(withCmaes.stages[0].search, fct::SearchStrategy::CmaEs);
+  EXPECT_EQ(withCmaes.stages[2].search, fct::SearchStrategy::Local) << "local stages stay local";
+  EXPECT_EQ(withCmaes.stages[1].metric, fct::SimilarityMetric::Vlnc) << "nothing else changes";
+  EXPECT_NE(withCmaes.name.find("cmaes"), std::string::npos);
+  fct::RegistrationAblation rois;
+  rois.noDynamicRois = true;
+  EXPECT_EQ(paper.withAblation(rois).stages[2].pixels.kind, fct::PixelSetKind::WholeImage);
+  EXPECT_EQ(paper.withAblation(rois).stages[2].level, 0);
+
+  // The Transgraph switch acts on the renderers (Registration), not on the stages: only the name changes.
+  fct::RegistrationAblation transgraph;
+  transgraph.noTransgraph = true;
+  EXPECT_EQ(transgraph.activeNames(), std::vector<std::string>{"no-transgraph"});
+  EXPECT_EQ(paper.withAblation(transgraph).toJson()["stages"], paper.toJson()["stages"]);
+  EXPECT_NE(paper.withAblation(transgraph).name.find("no-transgraph"), std::string::npos);
+  EXPECT_TRUE(paper.stages.back().exactDrr) << "the full-resolution stage renders exactly";
+  EXPECT_FALSE(paper.stages.front().exactDrr);
+}
+
+TEST(RegistrationSchedule, RoiPixelsReplaceEveryRoiStagesWindowAndFractionOnly) {
+  const auto fast = RegistrationSchedule::builtin("fast").value();
+  auto same = fast.withRoiPixels(7, 0.15);
+  ASSERT_TRUE(same.ok()) << same.error();
+  EXPECT_EQ(same.value().stages[0].pixels.kind, fct::PixelSetKind::WholeImage);
+  auto tuned = fast.withRoiPixels(9, 0.2);
+  ASSERT_TRUE(tuned.ok()) << tuned.error();
+  ASSERT_EQ(tuned.value().stages.size(), fast.stages.size());
+  EXPECT_EQ(tuned.value().stages[0].pixels.windowSize, fast.stages[0].pixels.windowSize) << "whole-image stage kept";
+  for (std::size_t i = 1; i < fast.stages.size(); ++i) {
+    EXPECT_EQ(tuned.value().stages[i].pixels.windowSize, 9);
+    EXPECT_DOUBLE_EQ(tuned.value().stages[i].pixels.targetFraction, 0.2);
+    EXPECT_EQ(tuned.value().stages[i].level, fast.stages[i].level);
+  }
+}
+
+TEST(RegistrationSchedule, RoiPixelsRejectABadWindowOrFraction) {
+  const auto fast = RegistrationSchedule::builtin("fast").value();
+  auto window = fast.withRoiPixels(1, 0.1);
+  ASSERT_FALSE(window.ok());
+  EXPECT_NE(window.error().find("2 to 64"), std::string::npos);
+  auto fraction = fast.withRoiPixels(7, 0.0);
+  ASSERT_FALSE(fraction.ok());
+  EXPECT_NE(fraction.error().find("(0, 1]"), std::string::npos);
+}

@@ -1,0 +1,92 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "Similarity/DynamicRoiSelector.h"
+#include "Similarity/VlncSimilarity.h"
+#include "SyntheticImages.h"
+
+namespace {
+
+fct::RoiSelection roisOf(const fct::FloatImage& image, double fraction) {
+  return fct::DynamicRoiSelector::create(image, fct::ValidMask::allValid(image.cols, image.rows))
+      .value()
+      .selectFraction(fraction)
+      .value();
+}
+
+}  // namespace
+
+TEST(VlncSimilarity, IdenticalIsOneNegatedIsMinusOneAndLocalOffsetsAreIgnored) {
+  const fct::FloatImage xray = fct::test::phantomImage();
+  const fct::RoiSelection rois = roisOf(xray, 0.15);
+  const auto vlnc = fct::VlncSimilarity::create(xray, rois);
+  ASSERT_TRUE(vlnc.ok()) << vlnc.error();
+  EXPECT_EQ(vlnc.value().windowCount(), rois.windows.size());
+  EXPECT_NEAR(vlnc.value().evaluate(xray).value(), 1.0, 1e-6);
+  EXPECT_NEAR(vlnc.value().evaluate(fct::test::affine(xray, -2.0f, 1.0f)).value(), -1.0, 1e-6);
+  EXPECT_NEAR(vlnc.value().evaluate(fct::test::affine(xray, 0.5f, 300.0f)).value(), 1.0, 1e-6);
+  // A different gain and offset in every 7x7 tile (e.g. uneven exposure) does not matter either.
+  fct::FloatImage uneven = xray;
+  for (int r = 0; r < xray.rows; ++r) {
+    for (int c = 0; c < xray.cols; ++c) uneven.at(c, r) = (1.0f + 0.1f * (c / 7)) * xray.at(c, r) + 3.0f * (r / 7);
+  }
+  EXPECT_NEAR(vlnc.value().evaluate(uneven).value(), 1.0, 1e-6);
+}
+
+TEST(VlncSimilarity, IsTheVarianceWeightedSumOfWindowNccs) {
+  // Two windows: X-ray variances 1 and 9 (weights 0.1, 0.9). The DRR matches the first and is constant in the second.
+  fct::FloatImage xray = fct::FloatImage::filled(14, 7);
+  fct::FloatImage drr = fct::FloatImage::filled(14, 7);
+  for (int r = 0; r < 7; ++r) {
+    for (int c = 0; c < 7; ++c) {
+      const float sign = ((r + c) % 2) ? 1.0f : -1.0f;  // checkerboard: variance ~ amplitude^2
+      xray.at(c, r) = sign;
+      xray.at(c + 7, r) = 3.0f * sign;
+      drr.at(c, r) = 5.0f * sign + 2.0f;
+      drr.at(c + 7, r) = 4.0f;
+    }
+  }
+  fct::RoiSelection rois;
+  rois.windowSize = 7;
+  rois.windows = {fct::RoiWindow{0, 0, 0, 0}, fct::RoiWindow{7, 0, 0, 0}};
+  const auto vlnc = fct::VlncSimilarity::create(xray, rois);
+  ASSERT_TRUE(vlnc.ok()) << vlnc.error();
+  EXPECT_NEAR(vlnc.value().evaluate(drr).value(), 0.1, 1e-6);
+  for (int r = 0; r < 7; ++r) {
+    for (int c = 0; c < 7; ++c) drr.at(c + 7, r) = -xray.at(c + 7, r);  // now anti-correlated in window 2
+  }
+  EXPECT_NEAR(vlnc.value().evaluate(drr).value(), 0.1 - 0.9, 1e-6);
+}
+
+TEST(VlncSimilarity, ConstantXrayWindowsWeighNothing) {
+  fct::FloatImage xray = fct::test::phantomImage(14, 7);
+  for (int r = 0; r < 7; ++r) {
+    for (int c = 7; c < 14; ++c) xray.at(c, r) = 2.0f;
+  }
+  fct::RoiSelection rois;
+  rois.windowSize = 7;
+  rois.windows = {fct::RoiWindow{0, 0, 0, 0}, fct::RoiWindow{7, 0, 0, 0}};
+  const auto vlnc = fct::VlncSimilarity::create(xray, rois);
+  ASSERT_TRUE(vlnc.ok());
+  EXPECT_EQ(vlnc.value().windowCount(), 1u);
+  EXPECT_NEAR(vlnc.value().evaluate(xray).value(), 1.0, 1e-6);
+  const fct::FloatImage flat = fct::FloatImage::filled(14, 7, 1.0f);
+  const auto none = fct::VlncSimilarity::create(flat, rois);
+  ASSERT_TRUE(none.ok());
+  EXPECT_FALSE(none.warnings().empty());
+  EXPECT_EQ(none.value().evaluate(xray).value(), 0.0);
+}
+
+TEST(VlncSimilarity, RejectsEmptySelectionsForeignWindowsAndMismatchedSizes) {
+  const fct::FloatImage xray = fct::test::phantomImage(21, 14);
+  fct::RoiSelection rois;
+  rois.windowSize = 7;
+  EXPECT_FALSE(fct::VlncSimilarity::create(xray, rois).ok());
+  rois.windows = {fct::RoiWindow{15, 0, 0, 0}};
+  EXPECT_FALSE(fct::VlncSimilarity::create(xray, rois).ok());
+  rois.windows = {fct::RoiWindow{14, 7, 0, 0}};
+  const auto vlnc = fct::VlncSimilarity::create(xray, rois);
+  ASSERT_TRUE(vlnc.ok());
+  EXPECT_FALSE(vlnc.value().evaluate(fct::test::phantomImage(21, 15)).ok());
+}

@@ -1,0 +1,96 @@
+// MetalMaskDetector: a dark (high line integral) thin bar is masked with its dilation, smooth bone and its edges are
+// not, invalid pixels stay invalid and are not counted, a clean image loses nothing, and bad input fails.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "XrayPrep/MetalMaskDetector.h"
+
+namespace {
+
+/// A 160x120 line-integral image: soft tissue 1.0, a bone disc (centre 60,60, radius 30) adding 1.2 with a smooth
+/// 4 px edge, and optionally a 3 px wide vertical metal bar at columns 110..112, rows 20..99, adding `barExcess`.
+fct::FloatImage boneImage(float barExcess) {
+  fct::FloatImage image = fct::FloatImage::filled(160, 120, 1.0f);
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) {
+      const double r = std::hypot(col - 60.0, row - 60.0);
+      image.at(col, row) += static_cast<float>(1.2 / (1.0 + std::exp((r - 30.0) / 1.0)));
+      if (col >= 110 && col <= 112 && row >= 20 && row < 100) image.at(col, row) += barExcess;
+    }
+  }
+  return image;
+}
+
+}  // namespace
+
+TEST(MetalMaskDetector, MasksDarkBarWithDilationButNotBone) {
+  const fct::ValidMask field = fct::ValidMask::allValid(160, 120);
+  fct::MetalMaskOptions options;
+  options.dilation_px = 2;
+  const auto metal = fct::MetalMaskDetector(options).detect(boneImage(3.0f), field);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  const fct::ValidMask& mask = metal.value().mask;
+  EXPECT_FALSE(mask.isValid(111, 60));
+  EXPECT_FALSE(mask.isValid(108, 60)) << "dilated by 2 px";
+  EXPECT_TRUE(mask.isValid(107, 60));
+  EXPECT_TRUE(mask.isValid(111, 10)) << "beyond the bar's end plus dilation";
+  EXPECT_TRUE(mask.isValid(60, 60)) << "bone centre";
+  EXPECT_TRUE(mask.isValid(30, 60)) << "bone edge";
+  EXPECT_EQ(metal.value().metalPixelCount, static_cast<std::size_t>((3 + 4) * (80 + 4)));
+}
+
+TEST(MetalMaskDetector, CleanImageLosesNoPixel) {
+  const fct::ValidMask field = fct::ValidMask::allValid(160, 120);
+  const auto metal = fct::MetalMaskDetector().detect(boneImage(0.0f), field);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  EXPECT_EQ(metal.value().metalPixelCount, 0u);
+  EXPECT_EQ(metal.value().mask.valid, field.valid);
+}
+
+TEST(MetalMaskDetector, IgnoresInvalidPixelsAroundTheField) {
+  // Outside a circular field the line integral is at its clamp (black border); that must not raise the background
+  // nor count as metal, and the bar inside the field is still found.
+  fct::FloatImage image = boneImage(3.0f);
+  fct::ValidMask field = fct::ValidMask::allValid(160, 120);
+  field.excludeOutside(fct::PixelCircle{{80.0, 60.0}, 58.0});
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    if (!field.valid[i]) image.pixels[i] = 6.9f;
+  }
+  const auto metal = fct::MetalMaskDetector().detect(image, field);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  EXPECT_FALSE(metal.value().mask.isValid(111, 60));
+  EXPECT_FALSE(metal.value().mask.isValid(0, 0)) << "invalid stays invalid";
+  EXPECT_TRUE(metal.value().mask.isValid(80, 60));
+  EXPECT_TRUE(metal.value().mask.isValid(30, 60));
+}
+
+TEST(MetalMaskDetector, RejectsSizeMismatchBadOptionsAndNaN) {
+  const fct::FloatImage image = boneImage(0.0f);
+  EXPECT_FALSE(fct::MetalMaskDetector().detect(image, fct::ValidMask::allValid(10, 10)).ok());
+  fct::MetalMaskOptions badWindow;
+  badWindow.backgroundWindow_px = 1;
+  EXPECT_FALSE(fct::MetalMaskDetector(badWindow).detect(image, fct::ValidMask::allValid(160, 120)).ok());
+  fct::MetalMaskOptions badExcess;
+  badExcess.minExcess = 0.0;
+  EXPECT_FALSE(fct::MetalMaskDetector(badExcess).detect(image, fct::ValidMask::allValid(160, 120)).ok());
+  fct::FloatImage withNan = image;
+  withNan.at(5, 5) = std::nanf("");
+  const auto failed = fct::MetalMaskDetector().detect(withNan, fct::ValidMask::allValid(160, 120));
+  ASSERT_FALSE(failed.ok());
+  EXPECT_NE(failed.error().find("non-finite"), std::string::npos) << failed.error();
+}
+
+TEST(MetalMaskDetector, WindowInMillimetresFollowsThePixelSpacing) {
+  // At 0.5 mm pixels the 30 mm window is 60 px, wider than the 3 px bar: found. At 10 mm pixels the window (3 px) is
+  // as narrow as the bar, which then is not a narrow ridge.
+  const fct::ValidMask field = fct::ValidMask::allValid(160, 120);
+  const fct::FloatImage image = boneImage(3.0f);
+  const auto fine = fct::MetalMaskDetector().detect(image, field, 0.5);
+  ASSERT_TRUE(fine.ok()) << fine.error();
+  EXPECT_FALSE(fine.value().mask.isValid(111, 60));
+  const auto coarse = fct::MetalMaskDetector().detect(image, field, 10.0);
+  ASSERT_TRUE(coarse.ok()) << coarse.error();
+  EXPECT_TRUE(coarse.value().mask.isValid(111, 60));
+  EXPECT_FALSE(fct::MetalMaskDetector().detect(image, field, -1.0).ok());
+}
