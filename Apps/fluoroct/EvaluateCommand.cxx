@@ -251,7 +251,7 @@ int runEvaluate(const EvaluateOptions& o) {
     const TrialRecord& r = p.record;
     fmt::print(stderr, "[{}/{}] {} trial {}: initial sTRE {:.2f} mm -> {:.3f} mm (max {:.3f}) {}{} {:.1f} s{}, {} DRRs\n",
                p.finished, p.toRun, r.condition, r.trial, r.initialStre_mm, r.error.streMean_mm, r.error.streMax_mm,
-               r.status == "ok" ? (r.success ? "success" : "FAILURE") : r.status,
+               r.status == TrialStatus::Ok ? (r.success ? "success" : "FAILURE") : trialStatusName(r.status),
                r.reason.empty() ? "" : " (" + r.reason + ")", r.seconds,
                r.setupSeconds > 0 ? fmt::format(" (+{:.1f} s tables)", r.setupSeconds) : "", r.drrs);
   };

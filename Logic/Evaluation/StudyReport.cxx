@@ -145,7 +145,7 @@ std::string conditionTable(const StudyDefinition& study, const std::vector<Trial
 std::string failures(const std::vector<TrialRecord>& records, const StudyDefinition& study) {
   std::string text;
   for (const TrialRecord& r : records) {
-    if (r.study == study.name && r.status == "failed") {
+    if (r.study == study.name && r.status == TrialStatus::Failed) {
       text += fmt::format("- {} trial {}: {}\n", r.condition, r.trial, r.reason);
     }
   }
@@ -244,9 +244,9 @@ ConditionStats StudyReport::statistics(const std::vector<TrialRecord>& records) 
   int registered = 0;
   s.streMax_mm = kNan;
   for (const TrialRecord& r : records) {
-    if (r.status == "cancelled") continue;
+    if (r.status == TrialStatus::Cancelled) continue;
     ++s.trials;
-    if (r.status != "ok") continue;
+    if (r.status != TrialStatus::Ok) continue;
     ++registered;
     seconds.push_back(r.seconds);
     sumDrrs += static_cast<double>(r.drrs);

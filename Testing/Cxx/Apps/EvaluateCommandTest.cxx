@@ -53,7 +53,7 @@ void runQuickStudy(const std::string& study, const fs::path& out, const std::str
   ASSERT_TRUE(store.ok()) << store.error();
   EXPECT_EQ(static_cast<int>(store.value().records().size()), trials);
   for (const fct::TrialRecord& r : store.value().records()) {
-    EXPECT_EQ(r.status, "ok") << r.condition << ": " << r.reason;
+    EXPECT_EQ(r.status, fct::TrialStatus::Ok) << r.condition << ": " << r.reason;
     EXPECT_GT(r.drrs, 0);
   }
   int charts = 0;
