@@ -29,7 +29,6 @@ struct OptimizerTraits;
 
 template <>
 struct OptimizerTraits<fct::NelderMeadOptimizer> {
-  static constexpr const char* kName = "NelderMead";
   static constexpr bool kSeeded = false;  // deterministic by construction: no random numbers at all
   static fct::NelderMeadOptimizer make(std::uint32_t /*seed*/) { return fct::NelderMeadOptimizer(); }
   static constexpr const char* kBadOption = "tolerance";
@@ -42,7 +41,6 @@ struct OptimizerTraits<fct::NelderMeadOptimizer> {
 
 template <>
 struct OptimizerTraits<fct::GeneticSearchOptimizer> {
-  static constexpr const char* kName = "GeneticSearch";
   static constexpr bool kSeeded = true;
   static fct::GeneticSearchOptimizer make(std::uint32_t seed) {
     fct::GeneticSearchOptions options;
@@ -59,7 +57,6 @@ struct OptimizerTraits<fct::GeneticSearchOptimizer> {
 
 template <>
 struct OptimizerTraits<fct::CmaEsOptimizer> {
-  static constexpr const char* kName = "CmaEs";
   static constexpr bool kSeeded = true;
   static fct::CmaEsOptimizer make(std::uint32_t seed) {
     fct::CmaEsOptions options;
@@ -74,13 +71,6 @@ struct OptimizerTraits<fct::CmaEsOptimizer> {
   }
 };
 
-struct OptimizerNames {
-  template <typename Optimizer>
-  static std::string GetName(int) {
-    return OptimizerTraits<Optimizer>::kName;
-  }
-};
-
 template <typename Optimizer>
 class PoseOptimizerContract : public ::testing::Test {
  protected:
@@ -90,7 +80,7 @@ class PoseOptimizerContract : public ::testing::Test {
 };
 
 using ContractOptimizers = ::testing::Types<fct::NelderMeadOptimizer, fct::GeneticSearchOptimizer, fct::CmaEsOptimizer>;
-TYPED_TEST_SUITE(PoseOptimizerContract, ContractOptimizers, OptimizerNames);
+TYPED_TEST_SUITE(PoseOptimizerContract, ContractOptimizers);
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 

@@ -39,7 +39,6 @@ struct SimilarityTraits;
 
 template <>
 struct SimilarityTraits<fct::NccSimilarity> {
-  static constexpr const char* kName = "Ncc";
   static fct::Result<fct::NccSimilarity> create(const fct::FloatImage& xray) {
     return fct::NccSimilarity::create(xray, interiorPixels(xray));
   }
@@ -47,7 +46,6 @@ struct SimilarityTraits<fct::NccSimilarity> {
 
 template <>
 struct SimilarityTraits<fct::GradientCorrelationSimilarity> {
-  static constexpr const char* kName = "GradientCorrelation";
   static fct::Result<fct::GradientCorrelationSimilarity> create(const fct::FloatImage& xray) {
     return fct::GradientCorrelationSimilarity::create(xray, interiorPixels(xray));
   }
@@ -55,7 +53,6 @@ struct SimilarityTraits<fct::GradientCorrelationSimilarity> {
 
 template <>
 struct SimilarityTraits<fct::VlncSimilarity> {
-  static constexpr const char* kName = "Vlnc";
   /// VLNC compares windows, not a pixel list: every 7x7 window inside the margin. (The dynamic ROIs would choose
   /// among them by X-ray variance, and refuse a constant X-ray before VLNC could show how it handles one.)
   static fct::Result<fct::VlncSimilarity> create(const fct::FloatImage& xray) {
@@ -65,13 +62,6 @@ struct SimilarityTraits<fct::VlncSimilarity> {
       for (int c = kMargin; c + 7 <= xray.cols - kMargin; c += 7) windows.windows.push_back(fct::RoiWindow{c, r, 0, 0});
     }
     return fct::VlncSimilarity::create(xray, windows);
-  }
-};
-
-struct SimilarityNames {
-  template <typename Similarity>
-  static std::string GetName(int) {
-    return SimilarityTraits<Similarity>::kName;
   }
 };
 
@@ -95,7 +85,7 @@ class ImageSimilarityContract : public ::testing::Test {
 
 using ContractSimilarities =
     ::testing::Types<fct::NccSimilarity, fct::VlncSimilarity, fct::GradientCorrelationSimilarity>;
-TYPED_TEST_SUITE(ImageSimilarityContract, ContractSimilarities, SimilarityNames);
+TYPED_TEST_SUITE(ImageSimilarityContract, ContractSimilarities);
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
