@@ -212,11 +212,13 @@ int runEvaluate(const EvaluateOptions& o) {
   // The study and options are checked before anything is loaded (the CT labels are placeholders here).
   auto known = defineStudy(o, {"ct"});
   if (!known) return reportError(known.error());
-  if (o.jobs < 1) return reportError(fmt::format("--jobs must be at least 1, got {}", o.jobs));
+  if (o.jobs < 1 || o.jobs > StudyRunner::kMaxJobs) {
+    return reportError(fmt::format("--jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, o.jobs));
+  }
   if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
   if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
   auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
-  if (!store) return reportError(store.error());
+  if (!store) return reportError("--out: " + store.error());
   const std::string setup = setupText(o, known.value().setup);
   if (Status same = checkAndStoreSetup(o.out, setup, !store.value().records().empty()); !same) {
     return reportError(same.error());

@@ -28,7 +28,6 @@ namespace fct {
 
 namespace {
 
-constexpr int kMaxJobs = 64;
 constexpr int kMaxViews = 5;
 
 /// Everything about one CT that its trials share: error measures, truth and the simulated X-rays (all views).
@@ -51,8 +50,8 @@ std::string caseKey(const StudyCondition& c, const Volume& ct) {
 }
 
 Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, const StudyRunOptions& options) {
-  if (options.jobs < 1 || options.jobs > kMaxJobs) {
-    return fail(fmt::format("--jobs must be between 1 and {}, got {}", kMaxJobs, options.jobs));
+  if (options.jobs < 1 || options.jobs > StudyRunner::kMaxJobs) {
+    return fail(fmt::format("parallel jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, options.jobs));
   }
   if (study.conditions.empty()) return fail(fmt::format("study '{}' has no condition", study.name));
   std::set<std::string> names;

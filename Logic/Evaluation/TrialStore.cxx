@@ -124,7 +124,7 @@ Result<std::vector<TrialRecord>> TrialStore::fromCsv(const std::string& text, co
     if (lineNumber == 1) {
       if (f != columns()) {
         return fail(fmt::format("{}: the header is not that of a FluoroCT trials file ({} columns expected, starting "
-                                "'study,ct,condition'); use another --out folder or delete the file",
+                                "'study,ct,condition'); use another output folder or delete the file",
                                 where, columns().size()));
       }
       continue;

@@ -217,6 +217,19 @@ TEST(EvaluateCommand, BadInputGivesOneErrorLine) {
   const auto jobs = fct::test::runCli(fmt::format("evaluate --study views --quick --jobs 0 --out '{}'", (dir / "j").string()));
   EXPECT_EQ(jobs.exitCode, 2);
   EXPECT_NE(jobs.err.find("--jobs"), std::string::npos) << jobs.err;
+  const auto tooMany =
+      fct::test::runCli(fmt::format("evaluate --study views --quick --jobs 65 --out '{}'", (dir / "j").string()));
+  EXPECT_EQ(tooMany.exitCode, 2);
+  EXPECT_EQ(tooMany.err.rfind("error: --jobs must be between 1 and 64, got 65", 0), 0u) << tooMany.err;
+  EXPECT_FALSE(fs::exists(dir / "j"));
+
+  fs::create_directories(dir / "foreign");
+  ASSERT_TRUE(fct::TextFile::writeAtomically(dir / "foreign" / "trials.csv", "a,b\n1,2\n").ok());
+  const auto foreign =
+      fct::test::runCli(fmt::format("evaluate --study views --quick --out '{}'", (dir / "foreign").string()));
+  EXPECT_EQ(foreign.exitCode, 2);
+  EXPECT_EQ(foreign.err.rfind("error: --out: ", 0), 0u) << foreign.err;
+  EXPECT_NE(foreign.err.find("use another output folder"), std::string::npos) << foreign.err;
 }
 
 TEST(EvaluateCommand, FullStudyWithoutTheSharedDataIsSkippedWithAMessage) {

@@ -80,6 +80,8 @@ TEST(TrialStore, ForeignOrDamagedFilesAreRejectedNamingTheProblem) {
   const auto foreign = fct::TrialStore::open(dir / "other.csv");
   ASSERT_FALSE(foreign.ok());
   EXPECT_NE(foreign.error().find("header"), std::string::npos) << foreign.error();
+  EXPECT_NE(foreign.error().find("use another output folder"), std::string::npos) << foreign.error();
+  EXPECT_EQ(foreign.error().find("--"), std::string::npos) << "no command-line flag in Logic: " << foreign.error();
 
   std::string csv = fct::TrialStore::toCsv({record("phantom/ideal", 0, fct::TrialStatus::Ok)});
   csv += "table2,phantom,phantom/ideal,ideal,full,3,1,2,ten\n";
