@@ -130,7 +130,9 @@ TEST(EvaluateCommand, QuickAblationWithTransgraphHasANoTransgraphRow) {
   EXPECT_NE(report.find("DRR method `transgraph`"), std::string::npos) << report;
   const auto store = fct::TrialStore::open(out / "trials.csv").value();
   for (const fct::TrialRecord& r : store.records()) {
-    if (r.variant == "no-transgraph") EXPECT_EQ(r.setupSeconds, 0.0) << "no tables for the Siddon row";
+    if (r.variant == "no-transgraph") {
+      EXPECT_EQ(r.setupSeconds, 0.0) << "no tables for the Siddon row";
+    }
   }
   EXPECT_TRUE(fs::is_directory(out / "transgraph-cache"));
 }
