@@ -25,11 +25,9 @@ class GradientCorrelationSimilarity final : public ImageSimilarity {
   /// Number of compared pixels (border pixels left out).
   std::size_t pixelCount() const { return m_pixels.size(); }
 
- protected:
-  double compare(const FloatImage& drr) const override;
-
  private:
   GradientCorrelationSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
+  double compare(const FloatImage& drr) const override;
 
   PixelIndexList m_pixels;
   std::vector<float> m_gxCentred;  ///< X-ray Sobel x-gradient at m_pixels minus its mean

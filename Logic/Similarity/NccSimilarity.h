@@ -22,11 +22,9 @@ class NccSimilarity final : public ImageSimilarity {
   /// Number of compared pixels.
   std::size_t pixelCount() const { return m_pixels.size(); }
 
- protected:
-  double compare(const FloatImage& drr) const override;
-
  private:
   NccSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
+  double compare(const FloatImage& drr) const override;
 
   PixelIndexList m_pixels;
   std::vector<float> m_xrayCentred;  ///< X-ray values at m_pixels minus their mean

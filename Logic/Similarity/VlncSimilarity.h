@@ -27,11 +27,9 @@ class VlncSimilarity final : public ImageSimilarity {
   /// Number of windows with a nonzero weight.
   std::size_t windowCount() const { return m_weights.size(); }
 
- protected:
-  double compare(const FloatImage& drr) const override;
-
  private:
   VlncSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
+  double compare(const FloatImage& drr) const override;
 
   std::size_t m_windowPixels = 0;    ///< w*w
   PixelIndexList m_pixels;           ///< window by window, m_windowPixels each
