@@ -122,10 +122,10 @@ Status checkAndStoreSetup(const fs::path& out, const std::string& setup, bool ha
 std::atomic<bool> g_cancel{false};
 extern "C" void onEvaluateInterrupt(int) { g_cancel.store(true); }
 
-/// The shared data folder: $FLUOROCT_DATA_DIR, else ../shared/data from the working folder.
+/// The shared data folder named by $FLUOROCT_DATA_DIR; empty when it is not set.
 fs::path dataDir() {
   const char* env = std::getenv("FLUOROCT_DATA_DIR");
-  return env && *env ? fs::path(env) : fs::path("../shared/data");
+  return env && *env ? fs::path(env) : fs::path();
 }
 
 /// A label for a CT path: its file or folder name without image extensions, unique among `taken`.
@@ -146,9 +146,10 @@ std::string labelFor(const fs::path& path, const std::vector<StudyCt>& taken) {
   return label;
 }
 
-/// The CTs of the run: --ct paths; else the phantom (--quick); else the shared data's (pelvis, and the head phantom
-/// for table2). An empty list with no error means "skip": the shared data is missing.
-Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, bool& skip) {
+/// The CTs of the run: --ct paths; else the phantom (--quick); else those of the data folder $FLUOROCT_DATA_DIR
+/// (pelvis, and the head phantom for table2). Fails, naming both ways to give the CTs, when neither --ct nor
+/// FLUOROCT_DATA_DIR is given or the folder lacks a CT; fails on a CT that cannot be read.
+Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o) {
   std::vector<StudyCt> cts;
   std::vector<std::pair<std::string, fs::path>> paths;
   for (const std::string& p : o.cts) paths.emplace_back("", p);
@@ -163,15 +164,19 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, bool& skip) {
   }
   if (paths.empty()) {
     const fs::path data = dataDir();
+    if (data.empty()) {
+      return fail(fmt::format("the full '{}' study needs CTs: give them with --ct PATH ..., or set FLUOROCT_DATA_DIR to "
+                              "the data folder that holds ct/pelvis_totalseg.nii.gz (or use --quick for the built-in "
+                              "phantom)",
+                              o.study));
+    }
     paths.emplace_back("pelvis", data / "ct/pelvis_totalseg.nii.gz");
     if (o.study == "table2") paths.emplace_back("head", data / "ct/head_phantom_philips_bone");
     for (const auto& [label, path] : paths) {
       if (!fs::exists(path)) {
-        fmt::print(stderr, "evaluate: skipped: the full '{}' study needs {}, which does not exist (set "
-                           "FLUOROCT_DATA_DIR to the shared data folder, give --ct PATH, or run --quick)\n",
-                   o.study, path.string());
-        skip = true;
-        return cts;
+        return fail(fmt::format("the full '{}' study needs {}, which does not exist; set FLUOROCT_DATA_DIR to the data "
+                                "folder that holds it, or give the CTs with --ct PATH ...",
+                                o.study, path.string()));
       }
     }
   }
@@ -212,20 +217,20 @@ int runEvaluate(const EvaluateOptions& o) {
   // The study and options are checked before anything is loaded (the CT labels are placeholders here).
   auto known = defineStudy(o, {"ct"});
   if (!known) return reportError(known.error());
-  if (o.jobs < 1) return reportError(fmt::format("--jobs must be at least 1, got {}", o.jobs));
+  if (o.jobs < 1 || o.jobs > StudyRunner::kMaxJobs) {
+    return reportError(fmt::format("--jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, o.jobs));
+  }
   if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
   if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
   auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
-  if (!store) return reportError(store.error());
+  if (!store) return reportError("--out: " + store.error());
   const std::string setup = setupText(o, known.value().setup);
   if (Status same = checkAndStoreSetup(o.out, setup, !store.value().records().empty()); !same) {
     return reportError(same.error());
   }
 
-  bool skip = false;
-  auto cts = loadCts(o, skip);
+  auto cts = loadCts(o);
   if (!cts) return reportError(cts.error());
-  if (skip) return 0;
   std::vector<std::string> labels;
   for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
   auto study = defineStudy(o, labels);
@@ -251,7 +256,7 @@ int runEvaluate(const EvaluateOptions& o) {
     const TrialRecord& r = p.record;
     fmt::print(stderr, "[{}/{}] {} trial {}: initial sTRE {:.2f} mm -> {:.3f} mm (max {:.3f}) {}{} {:.1f} s{}, {} DRRs\n",
                p.finished, p.toRun, r.condition, r.trial, r.initialStre_mm, r.error.streMean_mm, r.error.streMax_mm,
-               r.status == "ok" ? (r.success ? "success" : "FAILURE") : r.status,
+               r.status == TrialStatus::Ok ? (r.success ? "success" : "FAILURE") : trialStatusName(r.status),
                r.reason.empty() ? "" : " (" + r.reason + ")", r.seconds,
                r.setupSeconds > 0 ? fmt::format(" (+{:.1f} s tables)", r.setupSeconds) : "", r.drrs);
   };
@@ -298,8 +303,8 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--trials", options->trials,
                       "At most this many trials per condition (a sample of a study; the first N of each condition)");
   command->add_option("--ct", options->cts,
-                      "CT volume(s) or DICOM folder(s) instead of the defaults (full: ../shared/data pelvis, plus the "
-                      "head phantom for table2; quick: the phantom)");
+                      "CT volume(s) or DICOM folder(s) instead of the defaults (full: the pelvis of $FLUOROCT_DATA_DIR, "
+                      "plus its head phantom for table2; quick: the phantom)");
   command->add_option("--preset", options->preset,
                       "Registration preset: paper, fast or a preset FILE.json (default: paper; --quick: fast)");
   command->add_option("--detector", options->detector,

@@ -67,7 +67,13 @@ int printCt(const InfoOptions& options) {
     }
   }
   const auto loaded = CtLoader::load(options.path, dicomOptions);
-  if (!loaded.ok()) return reportError(loaded.error());
+  if (!loaded.ok()) {
+    // The reader says in its own words that it refused an irregular series; name the option that asked it to.
+    const bool refused = options.refuseIrregular && loaded.error().find("not on a regular grid") != std::string::npos;
+    return reportError(refused ? "--refuse-irregular: " + loaded.error() +
+                                     "; leave out --refuse-irregular to resample it (--resample-mm MM sets the spacing)"
+                               : loaded.error());
+  }
   const Volume& ct = loaded.value();
   const auto [lo, hi] = ct.valueRange();
   if (options.json) {

@@ -166,7 +166,12 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
         simulated = DrrXraySimulator::writeCase(ct.value(), views.value(), pose.value(), options->drr, options->out,
                                                 ctSource);
       }
-      if (!simulated.ok()) return reportError(simulated.error());
+      if (!simulated.ok()) {
+        // The simulator says it found no room for a gas pocket in its own words; name the option that asked for them.
+        const bool noRoomForGas = physical && options->physical.gasPocketCount > 0 &&
+                                  simulated.error().find("for a gas pocket") != std::string::npos;
+        return reportError(noRoomForGas ? "--gas-pockets: " + simulated.error() : simulated.error());
+      }
       for (std::size_t n = 0; n < simulated.value().views.size(); ++n) {
         const ViewSpec& view = simulated.value().views[n];
         fmt::print("wrote {} ({}x{}, max line integral {:.2f})\n", view.imagePath.string(),

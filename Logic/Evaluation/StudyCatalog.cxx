@@ -95,8 +95,8 @@ void addAblation(StudyDefinition& d, const std::vector<std::string>& cts) {
   }
   if (!transgraph) {
     d.gaps.push_back(fmt::format("Transgraph off: no row. This run registers with the {} method, so every row already "
-                                 "runs without the Transgraph; run with --method transgraph to get a 'no-transgraph' "
-                                 "row (exact Siddon DRRs) beside the Transgraph rows.",
+                                 "runs without the Transgraph; run the study with the transgraph DRR method to get a "
+                                 "'no-transgraph' row (exact Siddon DRRs) beside the Transgraph rows.",
                                  DrrRendererFactory::methodName(d.setup.method)));
   }
 }

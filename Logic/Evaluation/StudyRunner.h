@@ -41,10 +41,10 @@ struct StudyProgress {
 
 /// How to run a study.
 struct StudyRunOptions {
-  int jobs = 1;                                                  ///< trials in parallel (1..64)
+  int jobs = 1;                                                  ///< trials in parallel (1..StudyRunner::kMaxJobs)
   std::function<void(const StudyProgress&)> onTrial;             ///< after each trial (serialized)
   std::function<void(const std::string&)> onMessage;             ///< preparation steps (serialized)
-  const std::atomic<bool>* cancel = nullptr;                     ///< set to stop: running trials end as "cancelled"
+  const std::atomic<bool>* cancel = nullptr;                     ///< set to stop: running trials end as Cancelled
 };
 
 /// What a run did.
@@ -58,10 +58,13 @@ struct StudyRunSummary {
 /// Runs studies.
 class StudyRunner {
  public:
+  /// The most trials run in parallel.
+  static constexpr int kMaxJobs = 64;
+
   /// Runs the missing trials of `study` on `cts`, adding each to `store`. Fails before any trial on jobs outside
-  /// 1..64, a condition naming a CT not in `cts`, a view count outside 1..5, no trials, a bad initial range, an
+  /// 1..kMaxJobs, a condition naming a CT not in `cts`, a view count outside 1..5, no trials, a bad initial range, an
   /// unknown preset, a CT without bone, or a simulation or case preparation error; fails after a trial when the
-  /// store cannot be written (the trials so far stay in the file). A registration error is a "failed" trial.
+  /// store cannot be written (the trials so far stay in the file). A registration error is a Failed trial.
   static Result<StudyRunSummary> run(const StudyDefinition& study, const std::vector<StudyCt>& cts, TrialStore& store,
                                      const StudyRunOptions& options = {});
   /// Notes for the report: the X-ray forward model, and each condition whose registration CT is the original although

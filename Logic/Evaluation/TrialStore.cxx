@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -12,6 +13,9 @@
 namespace fct {
 
 namespace {
+
+/// The CSV names of the statuses, in the order of the TrialStatus enumerators.
+constexpr std::array<std::string_view, 3> kStatusNames{"ok", "failed", "cancelled"};
 
 std::string quoted(const std::string& field) {
   if (field.find_first_of(",\"\n\r") == std::string::npos) return field;
@@ -71,6 +75,15 @@ bool parseInt(const std::string& text, Int& out) {
 
 }  // namespace
 
+std::string_view trialStatusName(TrialStatus status) { return kStatusNames[static_cast<std::size_t>(status)]; }
+
+Result<TrialStatus> parseTrialStatus(std::string_view text) {
+  for (std::size_t i = 0; i < kStatusNames.size(); ++i) {
+    if (text == kStatusNames[i]) return static_cast<TrialStatus>(i);
+  }
+  return fail(fmt::format("unknown trial status '{}'; the status is ok, failed or cancelled", text));
+}
+
 const std::vector<std::string>& TrialStore::columns() {
   static const std::vector<std::string> kColumns{
       "study",   "ct",          "condition", "scenario",     "variant",          "views",
@@ -90,8 +103,7 @@ std::string TrialStore::toCsv(const std::vector<TrialRecord>& records) {
                         number(r.initialTarget_mm), number(r.initialStre_mm), number(r.error.streMean_mm),
                         number(r.error.streMax_mm), number(r.error.mtre_mm), number(r.error.rotation_deg),
                         number(r.error.translation_mm), r.success ? 1 : 0, number(r.seconds), number(r.setupSeconds), r.drrs,
-                        quoted(r.status),
-                        quoted(r.reason));
+                        trialStatusName(r.status), quoted(r.reason));
   }
   return text;
 }
@@ -112,7 +124,7 @@ Result<std::vector<TrialRecord>> TrialStore::fromCsv(const std::string& text, co
     if (lineNumber == 1) {
       if (f != columns()) {
         return fail(fmt::format("{}: the header is not that of a FluoroCT trials file ({} columns expected, starting "
-                                "'study,ct,condition'); use another --out folder or delete the file",
+                                "'study,ct,condition'); use another output folder or delete the file",
                                 where, columns().size()));
       }
       continue;
@@ -138,8 +150,12 @@ Result<std::vector<TrialRecord>> TrialStore::fromCsv(const std::string& text, co
       return fail(fmt::format("{} line {}: a number field cannot be read; fix or delete the line to resume", where,
                               lineNumber));
     }
+    auto status = parseTrialStatus(f[19]);
+    if (!status) {
+      return fail(fmt::format("{} line {}: {}; fix or delete the line to resume", where, lineNumber, status.error()));
+    }
     r.success = success != 0;
-    r.status = f[19];
+    r.status = status.value();
     r.reason = f[20];
     records.push_back(std::move(r));
   }
@@ -161,7 +177,9 @@ Result<TrialStore> TrialStore::open(const std::filesystem::path& csvPath) {
 
 bool TrialStore::isDone(const std::string& study, const std::string& condition, int trial) const {
   for (const TrialRecord& r : m_records) {
-    if (r.study == study && r.condition == condition && r.trial == trial) return r.status == "ok" || r.status == "failed";
+    if (r.study == study && r.condition == condition && r.trial == trial) {
+      return r.status == TrialStatus::Ok || r.status == TrialStatus::Failed;
+    }
   }
   return false;
 }

@@ -1,18 +1,31 @@
 #pragma once
 // TrialStore: the trials of a study as a CSV file (one row per trial, header first), kept on disk after every trial
 // so that an interrupted study resumes where it stopped: a trial is keyed by (study, condition, trial index), and a
-// key already stored with status "ok" or "failed" is not run again ("cancelled" ones are). Every save rewrites the
+// key already stored with status Ok or Failed is not run again (Cancelled ones are). Every save rewrites the
 // file atomically (temporary file, then rename), so it is never half-written.
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "Base/Result.h"
 #include "Evaluation/PoseErrorMetrics.h"
 
 namespace fct {
+
+/// How a trial ended; the CSV's `status` column spells it "ok", "failed" or "cancelled".
+enum class TrialStatus {
+  Ok,         ///< the registration ran to its end (its pose may still miss the success threshold)
+  Failed,     ///< the registration returned an error (see TrialRecord::reason)
+  Cancelled,  ///< stopped before the registration ended; a resumed study runs it again
+};
+
+/// The CSV spelling of `status`: "ok", "failed" or "cancelled".
+std::string_view trialStatusName(TrialStatus status);
+/// Parses the CSV spelling of a status; fails on any other text, naming it and the accepted ones.
+Result<TrialStatus> parseTrialStatus(std::string_view text);
 
 /// One registration trial of a study and its outcome.
 struct TrialRecord {
@@ -31,7 +44,7 @@ struct TrialRecord {
   double seconds = 0.0;           ///< registration time
   double setupSeconds = 0.0;      ///< Transgraph tables built or loaded for this trial before registering, seconds
   long drrs = 0;                  ///< DRRs rendered
-  std::string status = "ok";      ///< "ok", "failed" (registration returned an error) or "cancelled"
+  TrialStatus status = TrialStatus::Ok;  ///< how the trial ended
   std::string reason;             ///< the error or cancellation message
 };
 
@@ -42,11 +55,11 @@ class TrialStore {
   static const std::vector<std::string>& columns();
 
   /// Opens `csvPath`: reads its trials if it exists (resume), else starts empty (nothing is written until save).
-  /// Fails naming the file and line on a header other than columns(), a row with the wrong number of fields or a
-  /// bad number, or an unreadable file.
+  /// Fails naming the file and line on a header other than columns(), a row with the wrong number of fields, a
+  /// bad number or an unknown status, or an unreadable file.
   static Result<TrialStore> open(const std::filesystem::path& csvPath);
 
-  /// True if the trial is stored with status "ok" or "failed" (so a resumed study skips it).
+  /// True if the trial is stored with status Ok or Failed (so a resumed study skips it).
   bool isDone(const std::string& study, const std::string& condition, int trial) const;
   /// Stores `record` (replacing one with the same key) and rewrites the file atomically; fails on an unwritable file
   /// (the record is kept in memory).

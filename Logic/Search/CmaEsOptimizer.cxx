@@ -36,10 +36,8 @@ Status CmaEsOptimizer::validateOptions() const {
   return Ok{};
 }
 
-Result<OptimizationResult> CmaEsOptimizer::minimize(const PoseObjective& objective, const PoseVector& start,
-                                                    const PoseVector& scales, const ProgressMonitor& monitor) const {
-  if (auto status = validateInputs(objective, start, scales); !status) return fail(status.error());
-  if (auto status = validateOptions(); !status) return fail(status.error());
+OptimizationResult CmaEsOptimizer::search(const PoseObjective& objective, const PoseVector& start,
+                                          const PoseVector& scales, const ProgressMonitor& monitor) const {
   const auto& o = m_options;
   ObjectiveEvaluator evaluator(objective, start, scales, o.maxEvaluations, monitor);
   SeededRandom random(o.seed);
@@ -111,7 +109,7 @@ Result<OptimizationResult> CmaEsOptimizer::minimize(const PoseObjective& objecti
 
   OptimizationResult result = evaluator.result(converged);
   result.generations = std::move(records);
-  return finish(std::move(result), name());
+  return result;
 }
 
 }  // namespace fct

@@ -26,15 +26,16 @@ class CmaEsOptimizer : public PoseOptimizer {
 
   std::string name() const override { return "cma-es"; }
 
-  /// Minimizes from `start` (the initial mean); see PoseOptimizer::minimize. Reports progress per generation with
-  /// the evaluation count and best value; fills OptimizationResult::generations. Fails also on invalid options.
-  Result<OptimizationResult> minimize(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
-                                      const ProgressMonitor& monitor = ProgressMonitor()) const override;
-
   /// Checks the options; the error names the bad option and its value.
-  Status validateOptions() const;
+  Status validateOptions() const override;
 
   const CmaEsOptions& options() const { return m_options; }
+
+ protected:
+  /// CMA-ES from `start` (the initial mean). Reports progress per generation with the evaluation count and best
+  /// value; fills OptimizationResult::generations.
+  OptimizationResult search(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
+                            const ProgressMonitor& monitor) const override;
 
  private:
   CmaEsOptions m_options;

@@ -56,11 +56,8 @@ Status GeneticSearchOptimizer::validateOptions() const {
   return NelderMeadOptimizer(o.local).validateOptions();
 }
 
-Result<OptimizationResult> GeneticSearchOptimizer::minimize(const PoseObjective& objective, const PoseVector& start,
-                                                            const PoseVector& scales,
-                                                            const ProgressMonitor& monitor) const {
-  if (auto status = validateInputs(objective, start, scales); !status) return fail(status.error());
-  if (auto status = validateOptions(); !status) return fail(status.error());
+OptimizationResult GeneticSearchOptimizer::search(const PoseObjective& objective, const PoseVector& start,
+                                                  const PoseVector& scales, const ProgressMonitor& monitor) const {
   const auto& o = m_options;
   ObjectiveEvaluator evaluator(objective, start, scales, o.maxEvaluations, monitor);
   SeededRandom random(o.seed);
@@ -121,7 +118,7 @@ Result<OptimizationResult> GeneticSearchOptimizer::minimize(const PoseObjective&
 
   OptimizationResult result = evaluator.result(finished);
   result.generations = std::move(records);
-  return finish(std::move(result), name());
+  return result;
 }
 
 }  // namespace fct

@@ -34,20 +34,21 @@ class GeneticSearchOptimizer : public PoseOptimizer {
 
   std::string name() const override { return "genetic"; }
 
-  /// Minimizes from `start`; see PoseOptimizer::minimize. Reports progress per local search with the generation,
-  /// evaluation count and best value; fills OptimizationResult::generations. Fails also on invalid options.
-  Result<OptimizationResult> minimize(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
-                                      const ProgressMonitor& monitor = ProgressMonitor()) const override;
-
   /// The pose "a + lambda (b - a)" on the pose manifold: rotation R_a exp(lambda log(R_a^T R_b)) (geodesic, about the
   /// rotation centre), translation t_a + lambda (t_b - t_a). lambda = 0 gives a, 1 gives b; outside [0, 1] it
   /// extrapolates. Parameters as in PoseVector (deg, mm).
   static PoseVector combine(const PoseVector& a, const PoseVector& b, double lambda);
 
-  /// Checks the options; the error names the bad option and its value.
-  Status validateOptions() const;
+  /// Checks the options (the local search's too); the error names the bad option and its value.
+  Status validateOptions() const override;
 
   const GeneticSearchOptions& options() const { return m_options; }
+
+ protected:
+  /// The genetic search from `start`. Reports progress per local search with the generation, evaluation count and
+  /// best value; fills OptimizationResult::generations.
+  OptimizationResult search(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
+                            const ProgressMonitor& monitor) const override;
 
  private:
   GeneticSearchOptions m_options;

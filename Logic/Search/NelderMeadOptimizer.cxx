@@ -138,11 +138,8 @@ std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluat
   return {best, bestValue};
 }
 
-Result<OptimizationResult> NelderMeadOptimizer::minimize(const PoseObjective& objective, const PoseVector& start,
-                                                         const PoseVector& scales,
-                                                         const ProgressMonitor& monitor) const {
-  if (auto status = validateInputs(objective, start, scales); !status) return fail(status.error());
-  if (auto status = validateOptions(); !status) return fail(status.error());
+OptimizationResult NelderMeadOptimizer::search(const PoseObjective& objective, const PoseVector& start,
+                                               const PoseVector& scales, const ProgressMonitor& monitor) const {
   ObjectiveEvaluator evaluator(objective, start, scales, m_options.maxEvaluations, monitor);
   evaluator.reportEvery(kReportInterval, name());
   bool converged = false;
@@ -151,7 +148,7 @@ Result<OptimizationResult> NelderMeadOptimizer::minimize(const PoseObjective& ob
   monitor.report(name(), 1.0,
                  fmt::format("{} evaluations, best value {:.6g}{}", result.evaluations, result.value,
                              result.cancelled ? " (cancelled)" : ""));
-  return finish(std::move(result), name());
+  return result;
 }
 
 }  // namespace fct

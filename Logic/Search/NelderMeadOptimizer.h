@@ -24,19 +24,20 @@ class NelderMeadOptimizer : public PoseOptimizer {
 
   std::string name() const override { return "nelder-mead"; }
 
-  /// Minimizes from `start`; see PoseOptimizer::minimize. Fails also on invalid options (the message names them).
-  Result<OptimizationResult> minimize(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
-                                      const ProgressMonitor& monitor = ProgressMonitor()) const override;
-
   /// Runs one local search from `start_scaled` inside another strategy's evaluator (which counts, caps and cancels);
   /// returns the best scaled point and its value, and sets `converged` if the tolerance was reached.
   std::pair<PoseVector, double> searchScaled(ObjectiveEvaluator& evaluator, const PoseVector& start_scaled,
                                              bool* converged) const;
 
   /// Checks the options; the error names the bad option and its value.
-  Status validateOptions() const;
+  Status validateOptions() const override;
 
   const NelderMeadOptions& options() const { return m_options; }
+
+ protected:
+  /// One local search from `start` with restarts; reports progress every 25 evaluations and once at the end.
+  OptimizationResult search(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
+                            const ProgressMonitor& monitor) const override;
 
  private:
   NelderMeadOptions m_options;

@@ -35,11 +35,15 @@ Status PoseOptimizer::validateInputs(const PoseObjective& objective, const PoseV
   return Ok{};
 }
 
-Result<OptimizationResult> PoseOptimizer::finish(OptimizationResult result, const std::string& strategy) {
+Result<OptimizationResult> PoseOptimizer::minimize(const PoseObjective& objective, const PoseVector& start,
+                                                   const PoseVector& scales, const ProgressMonitor& monitor) const {
+  if (Status inputs = validateInputs(objective, start, scales); !inputs) return fail(inputs.error());
+  if (Status options = validateOptions(); !options) return fail(options.error());
+  OptimizationResult result = search(objective, start, scales, monitor);
   if (!std::isfinite(result.value) && !result.cancelled) {
     return fail(fmt::format("{}: the objective gave NaN or infinity at all {} evaluated poses; check that the poses "
                             "project the CT into the images",
-                            strategy, result.evaluations));
+                            name(), result.evaluations));
   }
   return result;
 }

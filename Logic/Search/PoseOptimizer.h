@@ -11,6 +11,9 @@
 // An objective value that is NaN (or the objective of a pose outside the images) counts as +infinity, the worst.
 // The ProgressMonitor's cancel flag is checked before every evaluation; a cancelled run returns the best pose found so
 // far with `cancelled` set (a Result that is ok()).
+//
+// minimize() is the one entry point: it checks the inputs and the variant's options once, runs the variant's search
+// and turns its best into the result. A variant implements validateOptions() and search() only.
 
 #include <Eigen/Core>
 
@@ -54,21 +57,28 @@ class PoseOptimizer {
   virtual std::string name() const = 0;
 
   /// Minimizes `objective` from `start` (deg, mm) with per-parameter `scales` (deg or mm per scaled unit).
-  /// Fails on an empty objective, a non-finite start, a non-positive or non-finite scale, invalid options, or when
-  /// every evaluated pose gave NaN/infinity. Progress goes to `monitor`; see the file comment for cancelling.
-  virtual Result<OptimizationResult> minimize(const PoseObjective& objective, const PoseVector& start,
-                                              const PoseVector& scales,
-                                              const ProgressMonitor& monitor = ProgressMonitor()) const = 0;
+  /// Fails, before any evaluation, on an empty objective, a non-finite start or a non-positive or non-finite scale
+  /// (naming the parameter) or invalid options (naming the option); fails after the run when every evaluated pose
+  /// gave NaN/infinity. Progress goes to `monitor`; see the file comment for cancelling.
+  Result<OptimizationResult> minimize(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
+                                      const ProgressMonitor& monitor = ProgressMonitor()) const;
+
+  /// Checks the variant's options; the error names the bad option and its value.
+  virtual Status validateOptions() const = 0;
 
   /// Scales for a bone of radius `radius_mm`: 1 deg moves its surface by radius_mm * pi / 180 mm, so the rotation
   /// scales are 180 / (pi * radius_mm) deg and the translation scales 1 mm. Fails for a non-positive radius.
   static Result<PoseVector> scalesForBoneRadius(double radius_mm);
 
  protected:
+  /// The variant's search, on inputs and options that minimize() has checked: returns the best pose found with its
+  /// value, evaluation count and flags (ObjectiveEvaluator::result); minimize() turns it into the final result.
+  virtual OptimizationResult search(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales,
+                                    const ProgressMonitor& monitor) const = 0;
+
+ private:
   /// Checks the inputs common to every strategy; the error names the bad parameter.
   static Status validateInputs(const PoseObjective& objective, const PoseVector& start, const PoseVector& scales);
-  /// Turns the best of a finished run into the final result; fails if no evaluation gave a finite value.
-  static Result<OptimizationResult> finish(OptimizationResult result, const std::string& strategy);
 };
 
 }  // namespace fct

@@ -22,9 +22,7 @@ inline float sobelY(const float* p, std::size_t i, std::size_t cols) {
 
 Result<GradientCorrelationSimilarity> GradientCorrelationSimilarity::create(const FloatImage& xray,
                                                                            const PixelIndexList& pixels) {
-  GradientCorrelationSimilarity metric;
-  metric.m_cols = xray.cols;
-  metric.m_rows = xray.rows;
+  GradientCorrelationSimilarity metric(xray.cols, xray.rows);
   const auto size = static_cast<std::int64_t>(xray.pixels.size());
   const auto cols = static_cast<std::size_t>(xray.cols);
   for (const std::int32_t index : pixels) {
@@ -54,14 +52,9 @@ Result<GradientCorrelationSimilarity> GradientCorrelationSimilarity::create(cons
   return result;
 }
 
-Result<double> GradientCorrelationSimilarity::evaluate(const FloatImage& drr) const {
-  if (drr.cols != m_cols || drr.rows != m_rows || drr.pixels.size() != static_cast<std::size_t>(m_cols) * m_rows) {
-    return fail(fmt::format("DRR is {}x{} but the X-ray is {}x{}; render the DRR with this view's camera at the same "
-                            "pyramid level",
-                            drr.cols, drr.rows, m_cols, m_rows));
-  }
+double GradientCorrelationSimilarity::compare(const FloatImage& drr) const {
   const float* d = drr.pixels.data();
-  const auto cols = static_cast<std::size_t>(m_cols);
+  const auto cols = static_cast<std::size_t>(drr.cols);
   const std::size_t n = m_pixels.size();
   const auto first = static_cast<std::size_t>(m_pixels[0]);
   NccAccumulator x(sobelX(d, first, cols));
@@ -71,9 +64,7 @@ Result<double> GradientCorrelationSimilarity::evaluate(const FloatImage& drr) co
     x.add(m_gxCentred[i], sobelX(d, p, cols));
     y.add(m_gyCentred[i], sobelY(d, p, cols));
   }
-  const double gc = 0.5 * (x.correlation(m_gxNorm, n) + y.correlation(m_gyNorm, n));
-  if (std::isnan(gc)) return fail("DRR has non-finite values near the compared pixels");
-  return gc;
+  return 0.5 * (x.correlation(m_gxNorm, n) + y.correlation(m_gyNorm, n));
 }
 
 }  // namespace fct

@@ -21,14 +21,14 @@ class GradientCorrelationSimilarity final : public ImageSimilarity {
   /// when no pixel with a full 3x3 neighbourhood remains.
   static Result<GradientCorrelationSimilarity> create(const FloatImage& xray, const PixelIndexList& pixels);
 
-  Result<double> evaluate(const FloatImage& drr) const override;
   std::string name() const override { return "GC"; }
   /// Number of compared pixels (border pixels left out).
   std::size_t pixelCount() const { return m_pixels.size(); }
 
  private:
-  int m_cols = 0;
-  int m_rows = 0;
+  GradientCorrelationSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
+  double compare(const FloatImage& drr) const override;
+
   PixelIndexList m_pixels;
   std::vector<float> m_gxCentred;  ///< X-ray Sobel x-gradient at m_pixels minus its mean
   std::vector<float> m_gyCentred;

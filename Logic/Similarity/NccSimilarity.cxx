@@ -11,9 +11,7 @@ namespace fct {
 Result<NccSimilarity> NccSimilarity::create(const FloatImage& xray, PixelIndexList pixels) {
   if (pixels.empty()) return fail("NCC needs at least one pixel to compare; the pixel set is empty");
   const auto size = static_cast<std::int64_t>(xray.pixels.size());
-  NccSimilarity metric;
-  metric.m_cols = xray.cols;
-  metric.m_rows = xray.rows;
+  NccSimilarity metric(xray.cols, xray.rows);
   metric.m_xrayCentred.resize(pixels.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     if (pixels[i] < 0 || pixels[i] >= size) {
@@ -33,21 +31,14 @@ Result<NccSimilarity> NccSimilarity::create(const FloatImage& xray, PixelIndexLi
   return result;
 }
 
-Result<double> NccSimilarity::evaluate(const FloatImage& drr) const {
-  if (drr.cols != m_cols || drr.rows != m_rows || drr.pixels.size() != static_cast<std::size_t>(m_cols) * m_rows) {
-    return fail(fmt::format("DRR is {}x{} but the X-ray is {}x{}; render the DRR with this view's camera at the same "
-                            "pyramid level",
-                            drr.cols, drr.rows, m_cols, m_rows));
-  }
+double NccSimilarity::compare(const FloatImage& drr) const {
   const float* d = drr.pixels.data();
   const std::int32_t* index = m_pixels.data();
   const float* x = m_xrayCentred.data();
   const std::size_t n = m_pixels.size();
   NccAccumulator sums(d[index[0]]);
   for (std::size_t i = 0; i < n; ++i) sums.add(x[i], d[index[i]]);
-  const double ncc = sums.correlation(m_xrayNorm, n);
-  if (std::isnan(ncc)) return fail("DRR has non-finite values in the compared pixels");
-  return ncc;
+  return sums.correlation(m_xrayNorm, n);
 }
 
 }  // namespace fct

@@ -18,14 +18,14 @@ class NccSimilarity final : public ImageSimilarity {
   /// the image. A constant X-ray is accepted (with a warning): every evaluation then gives 0.
   static Result<NccSimilarity> create(const FloatImage& xray, PixelIndexList pixels);
 
-  Result<double> evaluate(const FloatImage& drr) const override;
   std::string name() const override { return "NCC"; }
   /// Number of compared pixels.
   std::size_t pixelCount() const { return m_pixels.size(); }
 
  private:
-  int m_cols = 0;
-  int m_rows = 0;
+  NccSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
+  double compare(const FloatImage& drr) const override;
+
   PixelIndexList m_pixels;
   std::vector<float> m_xrayCentred;  ///< X-ray values at m_pixels minus their mean
   double m_xrayNorm = 0.0;

@@ -14,9 +14,7 @@ Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiS
     return fail("VLNC needs at least one window; the ROI selection is empty (lower the threshold or raise the "
                 "target fraction)");
   }
-  VlncSimilarity metric;
-  metric.m_cols = xray.cols;
-  metric.m_rows = xray.rows;
+  VlncSimilarity metric(xray.cols, xray.rows);
   metric.m_windowPixels = static_cast<std::size_t>(w) * w;
   std::vector<float> values(metric.m_windowPixels);
   PixelIndexList indices(metric.m_windowPixels);
@@ -53,12 +51,7 @@ Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiS
   return result;
 }
 
-Result<double> VlncSimilarity::evaluate(const FloatImage& drr) const {
-  if (drr.cols != m_cols || drr.rows != m_rows || drr.pixels.size() != static_cast<std::size_t>(m_cols) * m_rows) {
-    return fail(fmt::format("DRR is {}x{} but the X-ray is {}x{}; render the DRR with this view's camera at the same "
-                            "pyramid level",
-                            drr.cols, drr.rows, m_cols, m_rows));
-  }
+double VlncSimilarity::compare(const FloatImage& drr) const {
   const float* d = drr.pixels.data();
   const std::size_t m = m_windowPixels;
   double vlnc = 0.0;
@@ -69,8 +62,7 @@ Result<double> VlncSimilarity::evaluate(const FloatImage& drr) const {
     for (std::size_t i = 0; i < m; ++i) sums.add(x[i], d[index[i]]);
     vlnc += m_weights[window] * sums.correlation(m_xrayNorms[window], m);
   }
-  if (std::isnan(vlnc)) return fail("DRR has non-finite values in the compared windows");
-  return std::clamp(vlnc, -1.0, 1.0);
+  return std::clamp(vlnc, -1.0, 1.0);  // NaN stays NaN
 }
 
 }  // namespace fct

@@ -23,14 +23,14 @@ class VlncSimilarity final : public ImageSimilarity {
   /// `xray`). Fails on no window or a window not inside the image. All-constant windows give a warning.
   static Result<VlncSimilarity> create(const FloatImage& xray, const RoiSelection& selection);
 
-  Result<double> evaluate(const FloatImage& drr) const override;
   std::string name() const override { return "VLNC"; }
   /// Number of windows with a nonzero weight.
   std::size_t windowCount() const { return m_weights.size(); }
 
  private:
-  int m_cols = 0;
-  int m_rows = 0;
+  VlncSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
+  double compare(const FloatImage& drr) const override;
+
   std::size_t m_windowPixels = 0;    ///< w*w
   PixelIndexList m_pixels;           ///< window by window, m_windowPixels each
   std::vector<float> m_xrayCentred;  ///< X-ray values minus their window's mean, same layout

@@ -222,7 +222,7 @@ Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const
         set.m_objects.push_back(pocket);
       }
     }
-    if (!placed) return fail("found no soft tissue near the bone for a gas pocket; drop --gas-pockets for this CT");
+    if (!placed) return fail("found no soft tissue near the bone for a gas pocket; remove the gas pockets for this CT");
   }
   return set;
 }

@@ -380,7 +380,7 @@ Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeries
   const std::string irregularity = describeIrregularity(layout);
   if (!layout.isRegular() && options.policy == IrregularSeriesPolicy::Refuse) {
     return fail(fmt::format("series {} has {}, so its slices are not on a regular grid; read it with resampling "
-                            "(the default; choose the slice spacing with --resample-mm) or export it "
+                            "(the default policy, at the smallest slice gap or a spacing of your choice) or export it "
                             "from the scanner without tilt and gaps", uid, irregularity));
   }
   for (int k = 0; k < stack.sliceCount(); ++k) {

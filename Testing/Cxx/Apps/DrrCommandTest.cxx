@@ -121,7 +121,9 @@ TEST(DrrCommand, WritesPfmNrrdAndWindowedPng) {
     ASSERT_EQ(run.exitCode, 0) << run.err;
     const fs::path written = f.out / fmt::format("d_AP.{}", ext);
     ASSERT_TRUE(fs::exists(written));
-    if (std::string(ext) == "pfm") EXPECT_GE(fs::file_size(written), 65u * 49u * 4u);
+    if (std::string(ext) == "pfm") {
+      EXPECT_GE(fs::file_size(written), 65u * 49u * 4u);
+    }
   }
   const auto png = fct::XrayImageFileReader::read(f.out / "d_AP.png");
   ASSERT_TRUE(png.ok()) << png.error();

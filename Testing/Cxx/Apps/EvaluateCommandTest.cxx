@@ -1,5 +1,6 @@
 // fluoroct evaluate: the four quick studies end to end on the built-in phantom (CSV rows, valid PNG charts, report
-// tables), resume (and its refusal when the options differ), and bad input. The quick studies are what CI runs.
+// tables), resume (and its refusal when the options differ), bad input, and where a full study takes its CTs from
+// (--ct or $FLUOROCT_DATA_DIR only). The quick studies are what CI runs.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
@@ -8,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <string>
 
 #include "Base/TextFile.h"
@@ -53,7 +55,7 @@ void runQuickStudy(const std::string& study, const fs::path& out, const std::str
   ASSERT_TRUE(store.ok()) << store.error();
   EXPECT_EQ(static_cast<int>(store.value().records().size()), trials);
   for (const fct::TrialRecord& r : store.value().records()) {
-    EXPECT_EQ(r.status, "ok") << r.condition << ": " << r.reason;
+    EXPECT_EQ(r.status, fct::TrialStatus::Ok) << r.condition << ": " << r.reason;
     EXPECT_GT(r.drrs, 0);
   }
   int charts = 0;
@@ -65,6 +67,32 @@ void runQuickStudy(const std::string& study, const fs::path& out, const std::str
   EXPECT_EQ(charts, 2);
   EXPECT_NE(readText(out / "report.md").find(fmt::format("# Study `{}` (quick)", study)), std::string::npos);
 }
+
+/// Sets FLUOROCT_DATA_DIR (or unsets it, for nullopt) for the CLI runs of its lifetime, then restores it.
+class ScopedDataDir {
+ public:
+  explicit ScopedDataDir(const std::optional<fs::path>& folder) {
+    const char* previous = std::getenv("FLUOROCT_DATA_DIR");
+    if (previous) m_previous = previous;
+    if (folder) {
+      ::setenv("FLUOROCT_DATA_DIR", folder->c_str(), 1);
+    } else {
+      ::unsetenv("FLUOROCT_DATA_DIR");
+    }
+  }
+  ~ScopedDataDir() {
+    if (m_previous) {
+      ::setenv("FLUOROCT_DATA_DIR", m_previous->c_str(), 1);
+    } else {
+      ::unsetenv("FLUOROCT_DATA_DIR");
+    }
+  }
+  ScopedDataDir(const ScopedDataDir&) = delete;
+  ScopedDataDir& operator=(const ScopedDataDir&) = delete;
+
+ private:
+  std::optional<std::string> m_previous;
+};
 
 /// The setup.txt of `evaluate --study table2 --quick` (every default spelled out).
 const std::string kQuickTable2Setup =
@@ -102,7 +130,9 @@ TEST(EvaluateCommand, QuickAblationWithTransgraphHasANoTransgraphRow) {
   EXPECT_NE(report.find("DRR method `transgraph`"), std::string::npos) << report;
   const auto store = fct::TrialStore::open(out / "trials.csv").value();
   for (const fct::TrialRecord& r : store.records()) {
-    if (r.variant == "no-transgraph") EXPECT_EQ(r.setupSeconds, 0.0) << "no tables for the Siddon row";
+    if (r.variant == "no-transgraph") {
+      EXPECT_EQ(r.setupSeconds, 0.0) << "no tables for the Siddon row";
+    }
   }
   EXPECT_TRUE(fs::is_directory(out / "transgraph-cache"));
 }
@@ -217,21 +247,57 @@ TEST(EvaluateCommand, BadInputGivesOneErrorLine) {
   const auto jobs = fct::test::runCli(fmt::format("evaluate --study views --quick --jobs 0 --out '{}'", (dir / "j").string()));
   EXPECT_EQ(jobs.exitCode, 2);
   EXPECT_NE(jobs.err.find("--jobs"), std::string::npos) << jobs.err;
+  const auto tooMany =
+      fct::test::runCli(fmt::format("evaluate --study views --quick --jobs 65 --out '{}'", (dir / "j").string()));
+  EXPECT_EQ(tooMany.exitCode, 2);
+  EXPECT_EQ(tooMany.err.rfind("error: --jobs must be between 1 and 64, got 65", 0), 0u) << tooMany.err;
+  EXPECT_FALSE(fs::exists(dir / "j"));
+
+  fs::create_directories(dir / "foreign");
+  ASSERT_TRUE(fct::TextFile::writeAtomically(dir / "foreign" / "trials.csv", "a,b\n1,2\n").ok());
+  const auto foreign =
+      fct::test::runCli(fmt::format("evaluate --study views --quick --out '{}'", (dir / "foreign").string()));
+  EXPECT_EQ(foreign.exitCode, 2);
+  EXPECT_EQ(foreign.err.rfind("error: --out: ", 0), 0u) << foreign.err;
+  EXPECT_NE(foreign.err.find("use another output folder"), std::string::npos) << foreign.err;
 }
 
-TEST(EvaluateCommand, FullStudyWithoutTheSharedDataIsSkippedWithAMessage) {
+TEST(EvaluateCommand, FullStudyWithoutItsCtsFailsNamingBothWaysToGiveThem) {
   const auto dir = fct::test::scratchDir();
-  const char* previous = std::getenv("FLUOROCT_DATA_DIR");
-  const std::string saved = previous ? previous : "";
-  ::setenv("FLUOROCT_DATA_DIR", (dir / "no-data").c_str(), 1);
-  const auto run = fct::test::runCli(fmt::format("evaluate --study capture --out '{}'", (dir / "out").string()));
-  if (previous) {
-    ::setenv("FLUOROCT_DATA_DIR", saved.c_str(), 1);
-  } else {
-    ::unsetenv("FLUOROCT_DATA_DIR");
+  {
+    const ScopedDataDir unset(std::nullopt);
+    const auto run = fct::test::runCli(fmt::format("evaluate --study capture --out '{}'", (dir / "out").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_EQ(run.err.rfind("error: the full 'capture' study needs CTs: ", 0), 0u) << run.err;
+    EXPECT_NE(run.err.find("--ct PATH"), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("FLUOROCT_DATA_DIR"), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
   }
-  EXPECT_EQ(run.exitCode, 0) << run.err;
-  EXPECT_NE(run.err.find("evaluate: skipped: the full 'capture' study needs"), std::string::npos) << run.err;
-  EXPECT_NE(run.err.find("pelvis_totalseg.nii.gz"), std::string::npos) << run.err;
+  {
+    const ScopedDataDir empty(dir / "no-data");
+    const auto run = fct::test::runCli(fmt::format("evaluate --study capture --out '{}'", (dir / "out").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_EQ(run.err.rfind("error: the full 'capture' study needs ", 0), 0u) << run.err;
+    EXPECT_NE(run.err.find((dir / "no-data" / "ct" / "pelvis_totalseg.nii.gz").string()), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("--ct PATH"), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("FLUOROCT_DATA_DIR"), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
   EXPECT_FALSE(fs::exists(dir / "out" / "trials.csv"));
+}
+
+TEST(EvaluateCommand, FullStudyTakesItsCtFromTheDataFolderNamedByTheEnvironment) {
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  const auto out = fct::test::scratchDir() / "views";
+  const ScopedDataDir data(fct::test::dataDir());
+  const auto run = fct::test::runCli(fmt::format(
+      "evaluate --study views --trials 1 --preset fast --detector 160x128 --pixel-mm 2.4 --out '{}'", out.string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.err.find("loading CT " + (fct::test::dataDir() / "ct/pelvis_totalseg.nii.gz").string()),
+            std::string::npos)
+      << run.err;
+  const auto store = fct::TrialStore::open(out / "trials.csv");
+  ASSERT_TRUE(store.ok()) << store.error();
+  ASSERT_EQ(store.value().records().size(), 5u);  // 1 to 5 views, one trial each
+  for (const fct::TrialRecord& r : store.value().records()) EXPECT_EQ(r.ct, "pelvis") << r.condition;
 }

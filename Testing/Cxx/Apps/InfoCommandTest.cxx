@@ -1,3 +1,4 @@
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -83,4 +84,14 @@ TEST(InfoCommand, FrameOutOfRangeIsAnError) {
   expectCleanError(fct::test::runCli("info '" + (fct::test::dataDir() / "xray/xa_coronary_multiframe_jpeg.dcm").string() +
                                      "' --frame 96"),
                    "96 frame");
+}
+
+TEST(InfoCommand, RefusedIrregularSeriesNamesTheOptionThatRefusedIt) {
+  FCT_REQUIRE_DATA("ct/head_phantom_philips_tilted");
+  const auto run = fct::test::runCli(fmt::format("info '{}' --refuse-irregular",
+                                                 (fct::test::dataDir() / "ct/head_phantom_philips_tilted").string()));
+  expectCleanError(run, "gantry tilt 16.5");
+  EXPECT_EQ(run.err.rfind("error: --refuse-irregular: series ", 0), 0u) << run.err;
+  EXPECT_NE(run.err.find("leave out --refuse-irregular"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--resample-mm"), std::string::npos) << run.err;
 }

@@ -7,6 +7,7 @@
 #include "Base/TextFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
+#include "IO/Volume/VolumeFileIO.h"
 #include "IO/Xray/XrayImageFileReader.h"
 #include "TestSupport.h"
 
@@ -201,4 +202,21 @@ TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
                                                       (dir / "scaled.json").string(), out.string()));
   EXPECT_EQ(notRigid.exitCode, 2);
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(SimulateCommand, GasPocketsWithoutSoftTissueNameTheOption) {
+  const auto dir = workDir();
+  // Solid bone: no soft tissue anywhere for a gas pocket.
+  const auto bone = fct::Volume::create(Eigen::Vector3i(20, 20, 20), Eigen::Vector3d::Constant(4.0),
+                                        Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 1000.0f);
+  ASSERT_TRUE(bone.ok()) << bone.error();
+  ASSERT_TRUE(fct::VolumeFileIO::write(bone.value(), dir / "ct.nrrd").ok());
+  const auto views = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --count 1 --detector 40x40 --pixel-mm 4",
+                                                   (dir / "ct.nrrd").string(), (dir / "views.json").string()));
+  ASSERT_EQ(views.exitCode, 0) << views.err;
+  ASSERT_TRUE(fct::PoseFile::write(Eigen::Isometry3d::Identity(), dir / "pose.json").ok());
+  const auto run = fct::test::runCli(simulateCommand(dir, dir / "case") + " --model physical --gas-pockets 1");
+  EXPECT_EQ(run.exitCode, 2);
+  EXPECT_EQ(run.err.rfind("error: --gas-pockets: found no soft tissue near the bone", 0), 0u) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
 }

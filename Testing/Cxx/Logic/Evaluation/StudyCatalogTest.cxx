@@ -45,7 +45,8 @@ TEST(StudyCatalog, AblationWithSiddonReportsTheTransgraphGapInsteadOfARow) {
   const auto study = fct::StudyCatalog::define("ablation", true, {"phantom"}).value();
   for (const fct::StudyCondition& c : study.conditions) EXPECT_EQ(c.variant.find("transgraph"), std::string::npos);
   ASSERT_EQ(study.gaps.size(), 1u);
-  EXPECT_NE(study.gaps[0].find("--method transgraph"), std::string::npos) << study.gaps[0];
+  EXPECT_NE(study.gaps[0].find("transgraph DRR method"), std::string::npos) << study.gaps[0];
+  EXPECT_EQ(study.gaps[0].find("--"), std::string::npos) << "no command-line flag in Logic: " << study.gaps[0];
 }
 
 TEST(StudyCatalog, AblationWithTransgraphHasANoTransgraphRowAndNoGap) {

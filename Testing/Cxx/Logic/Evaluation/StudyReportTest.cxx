@@ -9,13 +9,13 @@
 namespace {
 
 fct::TrialRecord trial(const std::string& study, const std::string& condition, int index, double stre_mm,
-                       double seconds, const std::string& status = "ok") {
+                       double seconds, fct::TrialStatus status = fct::TrialStatus::Ok) {
   fct::TrialRecord r;
   r.study = study;
   r.condition = condition;
   r.trial = index;
   r.error = fct::PoseError{stre_mm, 2 * stre_mm, stre_mm, 0.1, 0.2};
-  r.success = stre_mm < 2.0 && status == "ok";
+  r.success = stre_mm < 2.0 && status == fct::TrialStatus::Ok;
   r.seconds = seconds;
   r.drrs = 1000;
   r.status = status;
@@ -26,8 +26,8 @@ fct::TrialRecord trial(const std::string& study, const std::string& condition, i
 
 TEST(StudyReport, StatisticsSeparateSuccessfulFailedAndCancelledTrials) {
   const std::vector<fct::TrialRecord> records{trial("t", "c", 0, 0.2, 3.0), trial("t", "c", 1, 0.4, 1.0),
-                                              trial("t", "c", 2, 5.0, 2.0), trial("t", "c", 3, NAN, 0.0, "failed"),
-                                              trial("t", "c", 4, 0.1, 9.0, "cancelled")};
+                                              trial("t", "c", 2, 5.0, 2.0), trial("t", "c", 3, NAN, 0.0, fct::TrialStatus::Failed),
+                                              trial("t", "c", 4, 0.1, 9.0, fct::TrialStatus::Cancelled)};
   const fct::ConditionStats s = fct::StudyReport::statistics(records);
   EXPECT_EQ(s.trials, 4);
   EXPECT_EQ(s.successes, 2);
@@ -48,9 +48,10 @@ TEST(StudyReport, EmptyConditionHasNoNumbers) {
 
 TEST(StudyReport, Table2ReportPutsThePaperBesideEachScenario) {
   const auto study = fct::StudyCatalog::define("table2", true, {"phantom"}).value();
-  const std::string text = fct::StudyReport::markdown(
-      study, {trial("table2", "phantom/ideal", 0, 0.25, 2.0), trial("table2", "phantom/bad", 0, NAN, 1.0, "failed")},
-      {"X-rays: test"});
+  const std::string text = fct::StudyReport::markdown(study,
+                                                      {trial("table2", "phantom/ideal", 0, 0.25, 2.0),
+                                                       trial("table2", "phantom/bad", 0, NAN, 1.0, fct::TrialStatus::Failed)},
+                                                      {"X-rays: test"});
   EXPECT_NE(text.find("| phantom | ideal | original | 1 | 100 % (1/1) | 0.25 |"), std::string::npos) << text;
   EXPECT_NE(text.find("| phantom | bad | 4.2 mm | 1 | 0 % (0/1) |"), std::string::npos) << text;
   EXPECT_NE(text.find("0.3–0.4"), std::string::npos);
@@ -72,4 +73,16 @@ TEST(StudyReport, CaptureReportGivesCumulativeFailureAndTheRange) {
   EXPECT_NE(text.find("| phantom | both | 10 |"), std::string::npos) << text;
   EXPECT_NE(text.find("| phantom | ncc-only | ≥ 20 (every bin tested) |"), std::string::npos)
       << "no bin failed, so the range is only a lower bound\n" << text;
+}
+
+TEST(StudyReport, PaperFiguresAreStatedPlainlyWithTheirSource) {
+  for (const char* name : {"table2", "capture"}) {
+    const auto study = fct::StudyCatalog::define(name, true, {"phantom"}).value();
+    const std::string text = fct::StudyReport::markdown(study, {}, {});
+    EXPECT_NE(text.find("The paper reports"), std::string::npos) << name << "\n" << text;
+    EXPECT_NE(text.find("(Knaan & Joskowicz, MICCAI 2003)"), std::string::npos) << name << "\n" << text;
+    for (const char* history : {"issue", "quoted", "#5"}) {
+      EXPECT_EQ(text.find(history), std::string::npos) << name << ": the report narrates ('" << history << "')\n" << text;
+    }
+  }
 }

@@ -44,6 +44,11 @@ TEST(StudyRunner, BadStudiesFailBeforeAnyTrial) {
   fct::StudyRunOptions options;
   options.jobs = 0;
   EXPECT_FALSE(fct::StudyRunner::run(study, cts, store, options).ok());
+  options.jobs = fct::StudyRunner::kMaxJobs + 1;
+  const auto tooMany = fct::StudyRunner::run(study, cts, store, options);
+  ASSERT_FALSE(tooMany.ok());
+  EXPECT_NE(tooMany.error().find("parallel jobs must be between 1 and 64, got 65"), std::string::npos) << tooMany.error();
+  EXPECT_EQ(tooMany.error().find("--"), std::string::npos) << "no command-line flag in Logic: " << tooMany.error();
   study.conditions.front().viewCount = 6;
   const auto sixViews = fct::StudyRunner::run(study, cts, store);
   ASSERT_FALSE(sixViews.ok());

@@ -144,14 +144,28 @@ TEST(Registration, EachAblationSwitchStillRuns) {
     ASSERT_TRUE(result.ok()) << result.error();
     EXPECT_NE(result.value().schedule.name.find(name), std::string::npos) << result.value().schedule.name;
     for (const auto& stage : result.value().schedule.stages) {
-      if (ablation.noPyramid) EXPECT_EQ(stage.level, 0);
-      if (ablation.nccOnly) EXPECT_EQ(stage.metric, fct::SimilarityMetric::Ncc);
-      if (ablation.localOnly) EXPECT_EQ(stage.search, fct::SearchStrategy::Local);
-      if (ablation.noDynamicRois) EXPECT_EQ(stage.pixels.kind, fct::PixelSetKind::WholeImage);
-      if (ablation.cmaesForGenetic) EXPECT_NE(stage.search, fct::SearchStrategy::Genetic);
+      if (ablation.noPyramid) {
+        EXPECT_EQ(stage.level, 0);
+      }
+      if (ablation.nccOnly) {
+        EXPECT_EQ(stage.metric, fct::SimilarityMetric::Ncc);
+      }
+      if (ablation.localOnly) {
+        EXPECT_EQ(stage.search, fct::SearchStrategy::Local);
+      }
+      if (ablation.noDynamicRois) {
+        EXPECT_EQ(stage.pixels.kind, fct::PixelSetKind::WholeImage);
+      }
+      if (ablation.cmaesForGenetic) {
+        EXPECT_NE(stage.search, fct::SearchStrategy::Genetic);
+      }
     }
-    if (ablation.noDynamicRois) EXPECT_GT(result.value().stages[1].keptFraction[0], 0.5);
-    if (ablation.cmaesForGenetic) EXPECT_EQ(result.value().stages[0].search, "cmaes");
+    if (ablation.noDynamicRois) {
+      EXPECT_GT(result.value().stages[1].keptFraction[0], 0.5);
+    }
+    if (ablation.cmaesForGenetic) {
+      EXPECT_EQ(result.value().stages[0].search, "cmaes");
+    }
     EXPECT_LT(errorOf(p, result.value().T_world_from_ct), errorOf(p, start));
   }
 }

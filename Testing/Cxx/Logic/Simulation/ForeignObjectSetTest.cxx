@@ -97,3 +97,17 @@ TEST(ForeignObjectSet, RejectsNoBoneAndBadSizes) {
   EXPECT_FALSE(fct::ForeignObjectSet::calibrationGrid(camera, 3.0, 2.0, 100.0).ok());
   EXPECT_FALSE(fct::ForeignObjectSet::calibrationGrid(camera, 30.0, 2.0, 1200.0).ok());
 }
+
+TEST(ForeignObjectSet, GasPocketsWithoutSoftTissueFailInTheModulesOwnWords) {
+  const fct::Volume bone =
+      fct::Volume::create(Eigen::Vector3i(8, 8, 8), Eigen::Vector3d::Constant(2.0), Eigen::Vector3d::Zero(),
+                          Eigen::Matrix3d::Identity(), 1000.0f)
+          .value();
+  fct::ImplantOptions options;
+  options.gasPocketCount = 1;
+  const auto placed = fct::ForeignObjectSet::placeNearBone(bone, options);
+  ASSERT_FALSE(placed.ok());
+  EXPECT_NE(placed.error().find("no soft tissue near the bone"), std::string::npos) << placed.error();
+  EXPECT_NE(placed.error().find("remove the gas pockets"), std::string::npos) << placed.error();
+  EXPECT_EQ(placed.error().find("--"), std::string::npos) << "no command-line flag in Logic: " << placed.error();
+}

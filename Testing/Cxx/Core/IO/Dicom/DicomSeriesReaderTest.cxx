@@ -187,6 +187,8 @@ TEST(DicomSeriesReader, ResamplesIrregularSyntheticSeriesWithWarning) {
   const auto refused = fct::DicomSeriesReader::read(dir, refuse);
   ASSERT_FALSE(refused.ok());
   EXPECT_TRUE(contains(refused.error(), "1.00–4.00 mm"));
+  EXPECT_TRUE(contains(refused.error(), "read it with resampling")) << refused.error();
+  EXPECT_FALSE(contains(refused.error(), "--")) << "no command-line flag in Core: " << refused.error();
 }
 
 TEST(DicomSeriesReader, PicksLargestOfTwoMixedSeriesAndScanListsBoth) {
