@@ -65,3 +65,12 @@ TEST(PoseFile, FailedWriteLeavesTheOldFileUntouched) {
   EXPECT_EQ(fct::TextFile::read(path).value(), before);
   EXPECT_FALSE(fct::PoseFile::write(obliquePose(), path.parent_path() / "missing" / "pose.json").ok());
 }
+
+TEST(PoseFile, ReadsTheRegisteredPoseOfAResultFileOfFormat1) {
+  // A RESULT.json of `fluoroct register` in format 1 (no "format" key), kept in Testing/Data/compat.
+  const auto read = fct::PoseFile::read(fct::test::fixtureDir() / "compat" / "RESULT-v1.json");
+  ASSERT_TRUE(read.ok()) << read.error();
+  EXPECT_NEAR(read.value().translation().x(), 1.928635690899748, 1e-12);
+  EXPECT_NEAR(read.value().translation().z(), 2.4187276194543705, 1e-12);
+  EXPECT_NEAR(read.value().linear()(0, 1), -0.03713716818520369, 1e-12);
+}
