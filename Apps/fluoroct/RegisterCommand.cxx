@@ -25,7 +25,7 @@
 #include "IO/Xray/ImageFileWriter.h"
 #include "IO/Xray/XrayLoader.h"
 #include "Registration/Registration.h"
-#include "Registration/RegistrationStagesJson.h"
+#include "Registration/RegistrationResultJson.h"
 
 namespace fct::cli {
 
@@ -134,29 +134,25 @@ Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const O
   return std::make_pair(e.T_world_from_ct, std::move(source));
 }
 
+/// RESULT.json: the result object (RegistrationResultJson) with where the initial pose came from, the Transgraph
+/// tables and the command's options added.
 nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o, nlohmann::ordered_json initial,
                                   nlohmann::ordered_json transgraph) {
-  initial["T_world_from_ct"] = JsonDocument::array(r.T_initial.matrix());
-  return nlohmann::ordered_json{
-      {"T_world_from_ct", JsonDocument::array(r.T_world_from_ct.matrix())},
-      {"cancelled", r.cancelled},
-      {"initial_pose", std::move(initial)},
-      {"stages", RegistrationStagesJson::write(r)},
-      {"total_seconds", r.totalSeconds},
-      {"total_drrs", r.totalDrrs},
-      {"transgraph", std::move(transgraph)},
-      {"rotation_centre_ct_mm", JsonDocument::array(r.rotationCentre_ct_mm)},
-      {"options",
-       {{"ct", o.ct},
-        {"views", o.views},
-        {"preset", o.preset},
-        {"seed", o.seed},
-        {"method", r.drrMethod},
-        {"ablation", o.ablation.activeNames()},
-        {"field_of_view_detection", !o.noFieldOfView},
-        {"metal_mask", !o.noMetalMask},
-        {"metal_min_excess", o.metalMinExcess},
-        {"schedule", r.schedule.toJson()}}}};
+  nlohmann::ordered_json json = RegistrationResultJson::write(r);
+  for (const auto& item : json["initial_pose"].items()) initial[item.key()] = item.value();
+  json["initial_pose"] = std::move(initial);
+  nlohmann::ordered_json options{{"ct", o.ct},
+                                 {"views", o.views},
+                                 {"preset", o.preset},
+                                 {"seed", o.seed},
+                                 {"ablation", o.ablation.activeNames()},
+                                 {"field_of_view_detection", !o.noFieldOfView},
+                                 {"metal_mask", !o.noMetalMask},
+                                 {"metal_min_excess", o.metalMinExcess}};
+  for (const auto& item : json["options"].items()) options[item.key()] = item.value();
+  json["options"] = std::move(options);
+  json["transgraph"] = std::move(transgraph);
+  return json;
 }
 
 /// Draws a one-line progress bar on stderr, at most every 100 ms.

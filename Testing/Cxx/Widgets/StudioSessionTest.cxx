@@ -2,6 +2,8 @@
 
 #include <fstream>
 
+#include "Base/JsonDocument.h"
+#include "Registration/RegistrationResultJson.h"
 #include "StudioDocument.h"
 #include "StudioSession.h"
 #include "StudioTestCase.h"
@@ -106,6 +108,24 @@ TEST(StudioSession, SaveThenOpenGivesTheSameDocument) {
   expectSameDocument(original, reopened);
   EXPECT_FALSE(reopened.isModified());
   EXPECT_EQ(reopened.sessionPath(), path);
+}
+
+TEST(StudioSession, SavesTheResultAsTheObjectOfResultFiles) {
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  StudioDocument document;
+  fillDocument(document);
+  const auto path = fct::test::scratchDir() / "case.fctsession.json";
+  ASSERT_TRUE(StudioSession::save(document, path).ok());
+  auto json = fct::JsonDocument::parse(path);
+  ASSERT_TRUE(json.ok()) << json.error();
+  EXPECT_EQ(json.value()["version"], 2);
+  const nlohmann::json& result = json.value()["result"];
+  EXPECT_EQ(result["format"], fct::RegistrationResultJson::kFormat);
+  EXPECT_EQ(result["verdict"], "rejected");
+  auto read = fct::RegistrationResultJson::read(result, "session: result");
+  ASSERT_TRUE(read.ok()) << read.error();
+  EXPECT_TRUE(read.value().T_initial.isApprox(document.result()->T_initial, 1e-12));
+  EXPECT_EQ(read.value().drrMethod, "raycast");
 }
 
 TEST(StudioSession, BadSessionFileLeavesTheDocumentAsItWas) {
