@@ -20,12 +20,11 @@
 #include "InitialPose/LandmarkPoseEstimator.h"
 #include "IO/Project/LandmarkFile.h"
 #include "IO/Project/PoseFile.h"
-#include "IO/Project/ViewFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
-#include "IO/Xray/XrayLoader.h"
 #include "Registration/Registration.h"
 #include "Registration/RegistrationResultJson.h"
+#include "Registration/RegistrationViewLoader.h"
 
 namespace fct::cli {
 
@@ -57,17 +56,6 @@ struct Options {
 std::atomic<bool> g_cancel{false};
 extern "C" void onInterrupt(int) { g_cancel.store(true); }
 
-Result<XrayImage> readImage(const ViewSpec& view) {
-  if (view.imagePath.empty()) {
-    return fail(fmt::format("view '{}' has no image; registration needs an X-ray per view (key \"image\" of the view "
-                            "file)",
-                            view.name));
-  }
-  auto image = XrayLoader::load(view.imagePath, view.frame);
-  if (!image) return fail(fmt::format("view '{}': {}", view.name, image.error()));
-  return image;
-}
-
 /// Writes a validity mask as an 8-bit-range PNG (white = compared, black = excluded), creating the folder.
 Status writeMaskPng(const ValidMask& mask, const fs::path& path) {
   std::error_code ec;
@@ -79,7 +67,7 @@ Status writeMaskPng(const ValidMask& mask, const fs::path& path) {
 
 /// The initial pose from --init or --landmarks, and a JSON description of where it came from.
 Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const Options& o,
-                                                                         const std::vector<ViewSpec>& views) {
+                                                                         const std::vector<RegistrationView>& views) {
   if (!o.init.empty()) {
     auto pose = PoseFile::read(o.init);
     if (!pose) return fail(pose.error());
@@ -102,11 +90,11 @@ Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const O
   auto imageLandmarks = LandmarkFile::readImage(folder / imageFile);
   if (!imageLandmarks) return fail(imageLandmarks.error());
   std::map<std::string, Camera> cameras;
-  for (const ViewSpec& view : views) cameras.emplace(view.name, view.camera);
+  for (const RegistrationView& view : views) cameras.emplace(view.name, view.camera);
   for (const auto& [viewName, clicks] : imageLandmarks.value()) {
     if (!cameras.count(viewName)) {
       std::vector<std::string> names;
-      for (const ViewSpec& view : views) names.push_back(view.name);
+      for (const RegistrationView& view : views) names.push_back(view.name);
       return fail(fmt::format("{}: landmarks are clicked in view '{}', which the view file does not have (views: {}); "
                               "the landmark and view files must name the same views",
                               (folder / imageFile).string(), viewName, fmt::join(names, ", ")));
@@ -186,9 +174,11 @@ int runRegister(const Options& o) {
   if (!method) return reportError(method.error());
   auto schedule = RegistrationSchedule::resolve(o.preset);
   if (!schedule) return reportError(schedule.error());
-  auto viewSpecs = ViewFile::read(o.views);
-  if (!viewSpecs) return reportError(viewSpecs.error());
-  auto initial = initialPose(o, viewSpecs.value());
+  auto loadedViews = RegistrationViewLoader::load(o.views);
+  if (!loadedViews) return reportError("--views: " + loadedViews.error());
+  for (const std::string& warning : loadedViews.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  const std::vector<RegistrationView>& views = loadedViews.value();
+  auto initial = initialPose(o, views);
   if (!initial) return reportError(initial.error());
   std::optional<Eigen::Isometry3d> T_truth;
   if (!o.truth.empty()) {
@@ -200,16 +190,6 @@ int runRegister(const Options& o) {
   if (!ct) return reportError(ct.error());
   for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
 
-  std::vector<RegistrationView> views;
-  for (const ViewSpec& spec : viewSpecs.value()) {
-    auto image = readImage(spec);
-    if (!image) return reportError(image.error());
-    RegistrationView view{spec.name, std::move(image).value(), spec.camera, {}};
-    for (const PixelCircle& sphere : spec.calibrationSpheres) {
-      view.spheres.push_back(PixelCircle{sphere.centre_px, sphere.radius_px});
-    }
-    views.push_back(std::move(view));
-  }
   RegistrationCaseOptions caseOptions;
   caseOptions.drr.method = method.value();
   caseOptions.drr.transgraph.spacing_mm = o.transgraphSpacing_mm;
