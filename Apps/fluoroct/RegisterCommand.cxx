@@ -14,11 +14,10 @@
 #include <vector>
 
 #include "Base/JsonDocument.h"
-#include "Base/JsonReader.h"
 #include "CliSupport.h"
 #include "Evaluation/ContourOverlay.h"
 #include "InitialPose/LandmarkPoseEstimator.h"
-#include "IO/Project/LandmarkFile.h"
+#include "IO/Project/LandmarkPairFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
@@ -70,39 +69,27 @@ Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const O
                                                                          const std::vector<RegistrationView>& views) {
   if (!o.init.empty()) {
     auto pose = PoseFile::read(o.init);
-    if (!pose) return fail(pose.error());
+    if (!pose) return fail("--init: " + pose.error());
     return std::make_pair(pose.value(), nlohmann::ordered_json{{"source", "pose file"}, {"path", o.init}});
   }
-  auto document = JsonDocument::parse(o.landmarks);
-  if (!document) return fail(document.error());
-  JsonReader reader(document.value(), o.landmarks);
-  const std::string ctFile = reader.string("ct");
-  const std::string imageFile = reader.string("image");
-  std::string method = "reprojection";
-  if (reader.has("method")) method = reader.string("method");
-  if (reader.ok() && method != "reprojection" && method != "triangulation") {
-    reader.rejectKey("method", fmt::format("is '{}'; use 'reprojection' or 'triangulation'", method));
-  }
-  if (!reader.ok()) return fail(reader.error());
-  const fs::path folder = fs::path(o.landmarks).parent_path();
-  auto ctLandmarks = LandmarkFile::readCt(folder / ctFile);
-  if (!ctLandmarks) return fail(ctLandmarks.error());
-  auto imageLandmarks = LandmarkFile::readImage(folder / imageFile);
-  if (!imageLandmarks) return fail(imageLandmarks.error());
+  auto pairs = LandmarkPairFile::read(o.landmarks);
+  if (!pairs) return fail("--landmarks: " + pairs.error());
+  for (const std::string& warning : pairs.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  const LandmarkPairSet& set = pairs.value();
   std::map<std::string, Camera> cameras;
   for (const RegistrationView& view : views) cameras.emplace(view.name, view.camera);
-  for (const auto& [viewName, clicks] : imageLandmarks.value()) {
+  for (const auto& [viewName, clicks] : set.landmarks.imageByView) {
     if (!cameras.count(viewName)) {
       std::vector<std::string> names;
       for (const RegistrationView& view : views) names.push_back(view.name);
       return fail(fmt::format("{}: landmarks are clicked in view '{}', which the view file does not have (views: {}); "
                               "the landmark and view files must name the same views",
-                              (folder / imageFile).string(), viewName, fmt::join(names, ", ")));
+                              set.imageFile.string(), viewName, fmt::join(names, ", ")));
     }
   }
-  const Landmarks landmarks{ctLandmarks.value(), imageLandmarks.value()};
-  auto estimate = method == "triangulation" ? LandmarkPoseEstimator::fromTriangulation(landmarks, cameras)
-                                            : LandmarkPoseEstimator::fromReprojection(landmarks, cameras);
+  auto estimate = set.method == LandmarkPoseMethod::Triangulation
+                      ? LandmarkPoseEstimator::fromTriangulation(set.landmarks, cameras)
+                      : LandmarkPoseEstimator::fromReprojection(set.landmarks, cameras);
   if (!estimate) return fail("initial pose from landmarks: " + estimate.error());
   const LandmarkPoseEstimate& e = estimate.value();
   nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
