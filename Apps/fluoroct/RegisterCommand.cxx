@@ -283,7 +283,8 @@ int runRegister(const Options& o) {
   }
   for (const StageReport& s : r.stages) {
     fmt::print("stage {:<16} {:>4} level {} {:<7} {:7.2f} s {:7} DRRs  similarity {:.4f} -> {:.4f}{}{}\n", s.name,
-               s.metric, s.level, s.search, s.seconds, s.drrs, s.startSimilarity, s.similarity,
+               RegistrationSchedule::metricName(s.metric), s.level, RegistrationSchedule::searchName(s.search), s.seconds,
+               s.drrs, s.startSimilarity, s.similarity,
                s.fallbackRays ? fmt::format("  ({} rays outside the Transgraph, exact)", s.fallbackRays) : "",
                s.cancelled ? " (cancelled)" : "");
   }

@@ -76,9 +76,21 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
   JsonReader reader(object, where);
   StageReport stage;
   stage.name = reader.string("name");
-  stage.metric = reader.string("metric");
+  if (const std::string metric = reader.string("metric"); reader.ok()) {
+    if (auto parsed = RegistrationSchedule::parseMetric(metric)) {
+      stage.metric = parsed.value();
+    } else {
+      reader.reject("key 'metric': " + parsed.error());
+    }
+  }
   stage.level = reader.integer("level", 0);
-  stage.search = reader.string("search");
+  if (const std::string search = reader.string("search"); reader.ok()) {
+    if (auto parsed = RegistrationSchedule::parseSearch(search)) {
+      stage.search = parsed.value();
+    } else {
+      reader.reject("key 'search': " + parsed.error());
+    }
+  }
   stage.seconds = reader.number("seconds");
   stage.drrs = count(reader, "drrs");
   stage.fallbackRays = count(reader, "fallback_rays");
@@ -116,9 +128,9 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
       kept[result.viewNames[v]] = s.keptFraction[v];
     }
     stages.push_back({{"name", s.name},
-                      {"metric", s.metric},
+                      {"metric", RegistrationSchedule::metricName(s.metric)},
                       {"level", s.level},
-                      {"search", s.search},
+                      {"search", RegistrationSchedule::searchName(s.search)},
                       {"seconds", s.seconds},
                       {"drrs", s.drrs},
                       {"fallback_rays", s.fallbackRays},

@@ -29,13 +29,14 @@ class RegistrationResultJson {
   static constexpr int kVersion = 2;
 
   /// The result as a version-2 object. Stage i's kept fractions are keyed by view_names (fractions without a view
-  /// name are left out); poses are 4x4 row-major, LPS mm.
+  /// name are left out); metrics and searches by their schedule names ("vlnc", "genetic"); poses are 4x4 row-major,
+  /// LPS mm.
   static nlohmann::ordered_json write(const RegistrationResult& result);
 
   /// Reads a result object of version 1 or 2; `where` names it in messages ("RESULT.json", "x.json: result").
-  /// Fails naming the key on a missing key, a wrong type, NaN, a pose that is not rigid, an invalid schedule, or a
-  /// format or version this program does not read. A version-1 object without view_names takes them from the first
-  /// stage's kept_fraction keys (in alphabetical order).
+  /// Fails naming the key on a missing key, a wrong type, NaN, a pose that is not rigid, an unknown stage metric or
+  /// search, an invalid schedule, or a format or version this program does not read. A version-1 object without
+  /// view_names takes them from the first stage's kept_fraction keys (in alphabetical order).
   static Result<RegistrationResult> read(const nlohmann::json& object, const std::string& where);
 };
 

@@ -47,9 +47,9 @@ void fillDocument(StudioDocument& d) {
   result.cancelled = true;
   fct::StageReport stage;
   stage.name = "coarse";
-  stage.metric = "ncc";
+  stage.metric = fct::SimilarityMetric::Ncc;
   stage.level = 2;
-  stage.search = "genetic";
+  stage.search = fct::SearchStrategy::Genetic;
   stage.similarity = 0.75;
   stage.keptFraction = {0.1, 0.2};
   result.stages.push_back(stage);

@@ -17,9 +17,9 @@ fct::RegistrationResult twoStageResult() {
   result.viewNames = {"ap", "lateral"};
   fct::StageReport first;
   first.name = "ncc-whole-1:16";
-  first.metric = "ncc";
+  first.metric = fct::SimilarityMetric::Ncc;
   first.level = 2;
-  first.search = "genetic";
+  first.search = fct::SearchStrategy::Genetic;
   first.drrs = 120;
   first.fallbackRays = 7;
   first.keptFraction = {0.5, 0.25};
@@ -41,9 +41,9 @@ fct::RegistrationResult fullResult() {
   r.viewNames = {"ap", "lateral.2"};  // a dot in a view name is kept as is
   fct::StageReport stage;
   stage.name = "vlnc-rois-1:4";
-  stage.metric = "vlnc";
+  stage.metric = fct::SimilarityMetric::Vlnc;
   stage.level = 1;
-  stage.search = "local";
+  stage.search = fct::SearchStrategy::Local;
   stage.seconds = 1.25;
   stage.drrs = 4000;
   stage.fallbackRays = 3'000'000'000L;  // more than an int holds
@@ -252,4 +252,16 @@ TEST(RegistrationResultJson, RefusesAnotherFormatAndANewerVersion) {
   const auto notObject = RegistrationResultJson::read(nlohmann::json::array(), "result.json");
   ASSERT_FALSE(notObject.ok());
   EXPECT_NE(notObject.error().find("must be a JSON object"), std::string::npos) << notObject.error();
+}
+
+TEST(RegistrationResultJson, StageMetricAndSearchAreWrittenByNameAndUnknownNamesRefused) {
+  const nlohmann::ordered_json json = RegistrationResultJson::write(fullResult());
+  EXPECT_EQ(json["stages"][0]["metric"], "vlnc");
+  EXPECT_EQ(json["stages"][0]["search"], "local");
+  EXPECT_NE(errorAfter([](nlohmann::json& j) { j["stages"][0]["metric"] = "mi"; })
+                .find("stages[0]: key 'metric': 'mi' is not a similarity metric; use one of ncc, vlnc, gc"),
+            std::string::npos);
+  EXPECT_NE(errorAfter([](nlohmann::json& j) { j["stages"][0]["search"] = "random"; })
+                .find("stages[0]: key 'search': 'random' is not a search strategy; use one of genetic, cmaes, local"),
+            std::string::npos);
 }
