@@ -38,8 +38,8 @@ Status StudySetupFile::checkOrWrite(const fs::path& folder, const std::string& s
   if (!hasTrials) return TextFile::writeAtomically(file, setupText);
   auto stored = TextFile::read(file);
   if (!stored) {
-    return fail(fmt::format("{} holds trials but no {} (made by an older fluoroct?), so the options it was run with are "
-                            "unknown; use another output folder",
+    return fail(fmt::format("{} holds trials but no {} (made by an older fluoroct?), so the options it was run with "
+                            "are unknown; use another output folder",
                             folder.string(), kFileName));
   }
   if (stored.value() == setupText) return Ok{};

@@ -22,7 +22,9 @@ Result<std::vector<RegistrationView>> RegistrationViewLoader::load(const std::fi
     }
     auto image = XrayLoader::load(spec.imagePath, spec.frame);
     if (!image) return fail(fmt::format("{}: view '{}': {}", viewFile.string(), spec.name, image.error()));
-    for (const std::string& warning : image.warnings()) warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
+    for (const std::string& warning : image.warnings()) {
+      warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
+    }
     const CameraIntrinsics& detector = spec.camera.intrinsics();
     if (image.value().cols != detector.cols || image.value().rows != detector.rows) {
       return fail(fmt::format("{}: view '{}': the image is {}x{} pixels but the detector is {}x{}; fix the view "

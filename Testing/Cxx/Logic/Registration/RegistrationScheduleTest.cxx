@@ -159,7 +159,8 @@ TEST(RegistrationSchedule, MetricAndSearchNamesParseBackAndUnknownNamesAreRefuse
     ASSERT_TRUE(parsed.ok()) << parsed.error();
     EXPECT_EQ(parsed.value(), metric);
   }
-  for (fct::SearchStrategy search : {fct::SearchStrategy::Genetic, fct::SearchStrategy::CmaEs, fct::SearchStrategy::Local}) {
+  for (fct::SearchStrategy search :
+       {fct::SearchStrategy::Genetic, fct::SearchStrategy::CmaEs, fct::SearchStrategy::Local}) {
     const auto parsed = fct::RegistrationSchedule::parseSearch(fct::RegistrationSchedule::searchName(search));
     ASSERT_TRUE(parsed.ok()) << parsed.error();
     EXPECT_EQ(parsed.value(), search);

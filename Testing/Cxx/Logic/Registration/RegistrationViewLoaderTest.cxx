@@ -15,8 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fct::Camera camera(int cols, int rows, double angle_rad) {
-  return fct::Camera::lookingAt(Eigen::Vector3d::Zero(), Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitY()).matrix(),
-                                700.0, 1000.0, cols, rows, 1.0);
+  const Eigen::Matrix3d R_world_from_camera = Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitY()).matrix();
+  return fct::Camera::lookingAt(Eigen::Vector3d::Zero(), R_world_from_camera, 700.0, 1000.0, cols, rows, 1.0);
 }
 
 /// A gradient image of `cols` x `rows` pixels written as PNG.
