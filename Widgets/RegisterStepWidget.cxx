@@ -261,8 +261,9 @@ void RegisterStepWidget::onFinished(const RegistrationResult& result) {
   for (const StageReport& stage : result.stages) {
     appendLog(QString::fromStdString(fmt::format(
         "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}", stage.name,
-        stage.metric, stage.level, stage.search, stage.evaluations, stage.drrs, stage.startSimilarity,
-        stage.similarity, stage.seconds, stage.cancelled ? " (cancelled)" : "")));
+        RegistrationSchedule::metricName(stage.metric), stage.level, RegistrationSchedule::searchName(stage.search),
+        stage.evaluations, stage.drrs, stage.startSimilarity, stage.similarity, stage.seconds,
+        stage.cancelled ? " (cancelled)" : "")));
   }
   QString summary = tr("%1 DRRs in %2 s").arg(result.totalDrrs).arg(result.totalSeconds, 0, 'f', 1);
   if (result.cancelled) {

@@ -7,9 +7,9 @@
 
 #include "Drr/DrrRendererFactory.h"
 #include "IO/Project/PoseFile.h"
-#include "IO/Project/ViewFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/XrayLoader.h"
+#include "Registration/RegistrationViewLoader.h"
 
 namespace fct {
 
@@ -61,30 +61,10 @@ void StudioDocument::setCt(std::shared_ptr<const Volume> ct, fs::path path, std:
 }
 
 Result<LoadedViews> StudioDocument::readViews(const fs::path& viewFile) {
-  auto specs = ViewFile::read(viewFile);
-  if (!specs) return fail(specs.error());
-  std::vector<std::string> warnings = specs.warnings();
-  std::vector<RegistrationView> views;
-  for (const ViewSpec& spec : specs.value()) {
-    if (spec.imagePath.empty()) {
-      return fail(fmt::format("{}: view '{}' has no image; add the key \"image\" with the X-ray file of the view",
-                              viewFile.string(), spec.name));
-    }
-    auto image = XrayLoader::load(spec.imagePath, spec.frame);
-    if (!image) return fail(fmt::format("{}: view '{}': {}", viewFile.string(), spec.name, image.error()));
-    for (const std::string& warning : image.warnings()) warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
-    RegistrationView view{spec.name, std::move(image).value(), spec.camera, {}};
-    if (view.xray.cols != spec.camera.intrinsics().cols || view.xray.rows != spec.camera.intrinsics().rows) {
-      return fail(fmt::format("{}: view '{}': the image is {}x{} pixels but the detector is {}x{}; fix the view "
-                              "file's detector size or give the matching image",
-                              viewFile.string(), spec.name, view.xray.cols, view.xray.rows,
-                              spec.camera.intrinsics().cols, spec.camera.intrinsics().rows));
-    }
-    for (const PixelCircle& sphere : spec.calibrationSpheres) {
-      view.spheres.push_back(PixelCircle{sphere.centre_px, sphere.radius_px});
-    }
-    views.push_back(std::move(view));
-  }
+  auto loaded = RegistrationViewLoader::load(viewFile);
+  if (!loaded) return fail(loaded.error());
+  std::vector<std::string> warnings = loaded.warnings();
+  std::vector<RegistrationView> views = std::move(loaded).value();
   std::optional<Eigen::Isometry3d> truth;
   const fs::path truthPath = viewFile.parent_path() / "truth_pose.json";
   std::error_code ec;

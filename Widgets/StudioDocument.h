@@ -2,8 +2,8 @@
 // StudioDocument: the state of one FluoroCT Studio session, shared by every step widget and view: the CT, the C-arm
 // views with their X-rays, the landmarks, the initial pose, the ROI parameters, the registration options and the last
 // result. Setters emit one specific signal per part and `changed()`; any change marks the document modified.
-// Loading goes through Core (CtLoader, ViewFile, XrayLoader) and never throws: failures come back as a Status whose
-// message says what to do, and leave the document as it was.
+// Loading goes through CtLoader, RegistrationViewLoader and XrayLoader and never throws: failures come back as a
+// Status whose message says what to do, and leave the document as it was.
 
 #include <Eigen/Geometry>
 #include <QObject>
@@ -101,7 +101,7 @@ class StudioDocument : public QObject {
   const std::filesystem::path& viewFilePath() const { return m_viewFilePath; }
   /// Warnings of the view load, in words.
   const std::vector<std::string>& viewWarnings() const { return m_viewWarnings; }
-  /// Reads a view file (ViewFile) and every view's image (XrayLoader), and truth_pose.json beside the view file as the
+  /// Reads a view file and every view's image (RegistrationViewLoader), and truth_pose.json beside the view file as the
   /// ground truth if present, without touching any document (safe on a worker thread). Fails naming the view.
   static Result<LoadedViews> readViews(const std::filesystem::path& viewFile);
   /// readViews() then setViews(). On failure the document is unchanged and the Status says why.

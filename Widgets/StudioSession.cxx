@@ -6,8 +6,8 @@
 
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
-#include "Geometry/RigidPose.h"
-#include "Registration/RegistrationStagesJson.h"
+#include "IO/Project/PoseFile.h"
+#include "Registration/RegistrationResultJson.h"
 
 namespace fct {
 
@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 using ordered_json = nlohmann::ordered_json;
 
 constexpr const char* kFormat = "fluoroct-studio-session";
-constexpr int kVersion = 1;
+/// Version 2 embeds the result as a RegistrationResultJson object; version 1 (its own result keys) is read too.
+constexpr int kVersion = 2;
 
 /// A path as written into a file in `folder`: relative when inside it, else absolute. Empty folder: absolute.
 std::string storedPath(const fs::path& path, const fs::path& folder) {
@@ -49,18 +50,11 @@ std::string verdictName(ResultVerdict verdict) {
 
 ordered_json pose(const Eigen::Isometry3d& T) { return JsonDocument::array(T.matrix()); }
 
+/// The result object shared with RESULT.json, with the user's verdict added.
 ordered_json resultJson(const RegistrationResult& r, ResultVerdict verdict) {
-  return ordered_json{{"T_world_from_ct", pose(r.T_world_from_ct)},
-                      {"T_initial", pose(r.T_initial)},
-                      {"rotation_centre_ct_mm", JsonDocument::array(r.rotationCentre_ct_mm)},
-                      {"cancelled", r.cancelled},
-                      {"verdict", verdictName(verdict)},
-                      {"total_seconds", r.totalSeconds},
-                      {"total_drrs", r.totalDrrs},
-                      {"drr_method", r.drrMethod},
-                      {"view_names", r.viewNames},
-                      {"stages", RegistrationStagesJson::write(r)},
-                      {"schedule", r.schedule.toJson()}};
+  ordered_json json = RegistrationResultJson::write(r);
+  json["verdict"] = verdictName(verdict);
+  return json;
 }
 
 /// The session document; paths relative to `folder` (absolute if empty).
@@ -111,28 +105,6 @@ ordered_json sessionJson(const StudioDocument& d, const fs::path& folder) {
   return json;
 }
 
-/// A required boolean.
-bool boolean(JsonReader& reader, std::string_view key) {
-  const nlohmann::json* value = reader.find(key);
-  if (!value || !value->is_boolean()) {
-    reader.rejectKey(key, value ? "must be true or false, not " + JsonReader::describe(*value) : "is missing");
-    return false;
-  }
-  return value->get<bool>();
-}
-
-/// A rigid pose at `key` (4x4 rows).
-std::optional<Eigen::Isometry3d> rigid(JsonReader& reader, std::string_view key) {
-  const Eigen::Matrix4d m = reader.matrix(key, 4, 4);
-  if (!reader.ok()) return std::nullopt;
-  auto validated = RigidPose::validated(m, std::string(key).c_str());
-  if (!validated) {
-    reader.rejectKey(key, validated.error());
-    return std::nullopt;
-  }
-  return validated.value();
-}
-
 /// Everything a session file holds, with the CT and X-rays loaded.
 struct SessionContent {
   std::optional<LoadedCt> ct;
@@ -149,13 +121,9 @@ struct SessionContent {
   bool isAutosave = false;
 };
 
+/// The result object (RegistrationResultJson) and the verdict beside it.
 Result<RegistrationResult> readResult(const nlohmann::json& json, const std::string& where, ResultVerdict& verdict) {
   JsonReader reader(json, where);
-  RegistrationResult r;
-  if (auto T = rigid(reader, "T_world_from_ct")) r.T_world_from_ct = *T;
-  if (auto T = rigid(reader, "T_initial")) r.T_initial = *T;
-  r.rotationCentre_ct_mm = reader.vector("rotation_centre_ct_mm", 3);
-  r.cancelled = boolean(reader, "cancelled");
   const std::string verdictText = reader.string("verdict");
   if (reader.ok()) {
     if (verdictText == "accepted") {
@@ -168,47 +136,8 @@ Result<RegistrationResult> readResult(const nlohmann::json& json, const std::str
       reader.rejectKey("verdict", fmt::format("is '{}'; use accepted, rejected or undecided", verdictText));
     }
   }
-  r.totalSeconds = reader.number("total_seconds");
-  r.totalDrrs = static_cast<long>(reader.integer("total_drrs", 0));
-  r.drrMethod = reader.string("drr_method");
-  if (const nlohmann::json* names = reader.find("view_names"); names && names->is_array()) {
-    for (const auto& name : *names) {
-      if (name.is_string()) r.viewNames.push_back(name.get<std::string>());
-    }
-  }
-  if (const nlohmann::json* stages = reader.find("stages"); stages && stages->is_array()) {
-    for (std::size_t i = 0; i < stages->size() && reader.ok(); ++i) {
-      JsonReader s((*stages)[i], fmt::format("{}: stages[{}]", where, i));
-      StageReport stage;
-      stage.name = s.string("name");
-      stage.metric = s.string("metric");
-      stage.level = s.integer("level", 0);
-      stage.search = s.string("search");
-      stage.seconds = s.number("seconds");
-      stage.drrs = static_cast<long>(s.integer("drrs", 0));
-      stage.evaluations = s.integer("evaluations", 0);
-      stage.startSimilarity = s.number("start_similarity");
-      stage.similarity = s.number("similarity");
-      stage.fallbackRays = static_cast<long>(s.integer("fallback_rays", 0));
-      if (const nlohmann::json* kept = s.find("kept_fraction"); kept && kept->is_object()) {
-        for (const std::string& view : r.viewNames) {
-          const auto value = kept->find(view);
-          if (value == kept->end() || !value->is_number()) break;
-          stage.keptFraction.push_back(value->get<double>());
-        }
-      }
-      stage.cancelled = boolean(s, "cancelled");
-      reader.adoptError(s);
-      r.stages.push_back(std::move(stage));
-    }
-  }
-  if (const nlohmann::json* schedule = reader.find("schedule"); schedule && reader.ok()) {
-    auto parsed = RegistrationSchedule::fromJson(*schedule, where + ": schedule");
-    if (!parsed) return fail(parsed.error());
-    r.schedule = std::move(parsed).value();
-  }
   if (!reader.ok()) return fail(reader.error());
-  return r;
+  return RegistrationResultJson::read(json, where);
 }
 
 Result<SessionContent> readSession(const fs::path& path) {
@@ -300,7 +229,7 @@ Result<SessionContent> readSession(const fs::path& path) {
   }
   if (reader.has("initial_pose")) {
     JsonReader initial(*reader.find("initial_pose"), where + ": initial_pose");
-    content.initialPose = rigid(initial, "T_world_from_ct");
+    content.initialPose = PoseFile::readKey(initial, "T_world_from_ct");
     if (initial.has("source")) {
       if (const nlohmann::json* source = initial.find("source"); source->is_string()) {
         content.initialPoseSource = QString::fromStdString(source->get<std::string>());
@@ -312,12 +241,12 @@ Result<SessionContent> readSession(const fs::path& path) {
     JsonReader roi(*reader.find("roi"), where + ": roi");
     RoiParameters& r = content.roi;
     r.windowSize = roi.integer("window_size", 2);
-    r.useThreshold = boolean(roi, "use_threshold");
+    r.useThreshold = roi.boolean("use_threshold");
     r.targetFraction = roi.positiveNumber("target_fraction");
     r.varianceThreshold = roi.number("variance_threshold");
     r.margin_px = roi.integer("margin_px", 0);
-    r.detectFieldOfView = boolean(roi, "detect_field_of_view");
-    r.detectSpheres = boolean(roi, "detect_spheres");
+    r.detectFieldOfView = roi.boolean("detect_field_of_view");
+    r.detectSpheres = roi.boolean("detect_spheres");
     r.sphereMargin_px = roi.number("sphere_margin_px");
     if (roi.ok() && r.targetFraction > 1.0) roi.rejectKey("target_fraction", "must be in (0, 1]");
     if (!roi.ok()) return fail(roi.error());
@@ -336,7 +265,7 @@ Result<SessionContent> readSession(const fs::path& path) {
   }
   if (reader.has("truth_pose")) {
     JsonReader truth(*reader.find("truth_pose"), where + ": truth_pose");
-    content.truthPose = rigid(truth, "T_world_from_ct");
+    content.truthPose = PoseFile::readKey(truth, "T_world_from_ct");
     if (!truth.ok()) return fail(truth.error());
   }
   return content;

@@ -3,9 +3,19 @@
 #include <fmt/core.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 
 namespace fct::cli {
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the SIGINT handler stores to the flag");
+
+extern "C" void onInterrupt(int) { g_interrupted.store(true); }
+
+}  // namespace
 
 int reportError(const std::string& message) {
   std::string oneLine = message;
@@ -31,5 +41,16 @@ CLI::Validator positiveNumber() {
       },
       "POSITIVE");
 }
+
+InterruptGuard::InterruptGuard() {
+  g_interrupted = false;
+  m_previous = std::signal(SIGINT, onInterrupt);
+}
+
+InterruptGuard::~InterruptGuard() {
+  if (m_previous != SIG_ERR) std::signal(SIGINT, m_previous);
+}
+
+const std::atomic<bool>* InterruptGuard::cancelFlag() { return &g_interrupted; }
 
 }  // namespace fct::cli

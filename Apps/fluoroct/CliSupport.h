@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <atomic>
 #include <functional>
 #include <string>
 
@@ -22,6 +23,24 @@ bool parseDetectorSize(const std::string& text, int& cols, int& rows);
 
 /// Option check: the value must be a finite number > 0; the message names the value given.
 CLI::Validator positiveNumber();
+
+/// While alive, Ctrl-C (SIGINT) sets cancelFlag() instead of ending the process, so a long Logic operation can stop
+/// cleanly; the previous handler is restored when the guard goes, on every path out of its scope. Create one at a time.
+class InterruptGuard {
+ public:
+  /// Clears the flag and installs the handler.
+  InterruptGuard();
+  /// Restores the handler that was installed before.
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+  /// The flag Ctrl-C sets (for ProgressMonitor and the cancel arguments of Logic).
+  static const std::atomic<bool>* cancelFlag();
+
+ private:
+  void (*m_previous)(int);
+};
 
 // Each command file provides a register function: it adds its subcommand to `app` and, when the subcommand is
 // chosen, stores its action in `action` (run after parsing).

@@ -1,6 +1,7 @@
 // fluoroct evaluate: runs one of the paper's studies (StudyCatalog) with simulated X-rays of known truth, writes every
 // trial to DIR/trials.csv (resumable), then DIR/report.md and PNG charts (StudyReport). The options that change results
-// (study, CTs, preset, detector, DRR method, ...) are kept in DIR/setup.txt; resuming with other options is refused.
+// (study, CTs, preset, detector, DRR method, ...) are kept in DIR/setup.txt (StudySetupFile); resuming with other
+// options is refused.
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -8,7 +9,6 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
-#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "Base/TextFile.h"
 #include "CliSupport.h"
 #include "Drr/DrrRendererFactory.h"
 #include "Evaluation/StudyCatalog.h"
 #include "Evaluation/StudyReport.h"
 #include "Evaluation/StudyRunner.h"
+#include "Evaluation/StudySetupFile.h"
 #include "Evaluation/TrialStore.h"
 #include "IO/Volume/CtLoader.h"
 #include "Registration/RegistrationSchedule.h"
@@ -72,51 +72,6 @@ Result<StudyDefinition> defineStudy(const EvaluateOptions& o, const std::vector<
   if (o.pixel_mm > 0.0) setup.detector.pixelSpacing_mm = o.pixel_mm;
   if (method.value() == DrrMethod::Transgraph) setup.transgraphCacheDir = transgraphCacheDir(o.out);
   return study;
-}
-
-/// The options of a run that change its results, one "key: value" line each (DIR/setup.txt; compared on resume).
-std::string setupText(const EvaluateOptions& o, const StudySetup& setup) {
-  const StandardViewOptions& d = setup.detector;
-  std::string preset = setup.preset;
-  if (fs::is_regular_file(preset)) {  // a preset file: its text matters, not only its name
-    auto text = TextFile::read(preset);
-    if (text) {
-      std::uint64_t hash = 14695981039346656037ull;  // FNV-1a of the file's text
-      for (unsigned char c : text.value()) hash = (hash ^ c) * 1099511628211ull;
-      preset += fmt::format(" (file, {} bytes, FNV-1a {:016x})", text.value().size(), hash);
-    }
-  }
-  return fmt::format("study: {}\nquick: {}\ncts: {}\npreset: {}\ndetector: {}x{}\npixel_mm: {:g}\nsid_mm: {:g}\n"
-                     "sad_mm: {:g}\nmethod: {}\ntransgraph_spacing_mm: {:g}\nseed: {}\n",
-                     o.study, o.quick ? "yes" : "no", o.cts.empty() ? "default" : fmt::format("{}", fmt::join(o.cts, " ")),
-                     preset, d.cols, d.rows, d.pixelSpacing_mm, d.sourceToDetector_mm, d.sourceToIsocentre_mm,
-                     DrrRendererFactory::methodName(setup.method), setup.transgraphSpacing_mm, setup.seed);
-}
-
-/// Resume check: a folder that already holds trials must have been run with the same setup. Writes DIR/setup.txt.
-Status checkAndStoreSetup(const fs::path& out, const std::string& setup, bool hasTrials) {
-  const fs::path file = out / "setup.txt";
-  if (hasTrials) {
-    auto stored = TextFile::read(file);
-    if (!stored) {
-      return fail(fmt::format("{} holds trials but no setup.txt (made by an older fluoroct?), so the options it was run "
-                              "with are unknown; use another --out",
-                              out.string()));
-    }
-    if (stored.value() != setup) {
-      std::string differences;
-      std::istringstream was(stored.value()), now(setup);
-      for (std::string a, b; std::getline(now, b);) {
-        if (!std::getline(was, a)) a = "(none)";
-        if (a != b) differences += fmt::format("{}'{}' now, '{}' stored", differences.empty() ? "" : "; ", b, a);
-      }
-      return fail(fmt::format("{} holds trials run with other options ({}); resume with the same options as in {}, or "
-                              "use another --out",
-                              out.string(), differences, file.string()));
-    }
-    return Ok{};
-  }
-  return TextFile::writeAtomically(file, setup);
 }
 
 std::atomic<bool> g_cancel{false};
@@ -224,13 +179,13 @@ int runEvaluate(const EvaluateOptions& o) {
   if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
   auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
   if (!store) return reportError("--out: " + store.error());
-  const std::string setup = setupText(o, known.value().setup);
-  if (Status same = checkAndStoreSetup(o.out, setup, !store.value().records().empty()); !same) {
-    return reportError(same.error());
-  }
-
+  // The CTs are found before setup.txt is written, so that a run without them leaves no setup behind.
   auto cts = loadCts(o);
   if (!cts) return reportError(cts.error());
+  const std::string setup = StudySetupFile::text(known.value(), o.cts);
+  if (Status same = StudySetupFile::checkOrWrite(o.out, setup, !store.value().records().empty()); !same) {
+    return reportError("--out: " + same.error());
+  }
   std::vector<std::string> labels;
   for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
   auto study = defineStudy(o, labels);

@@ -5,7 +5,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -14,18 +13,16 @@
 #include <vector>
 
 #include "Base/JsonDocument.h"
-#include "Base/JsonReader.h"
 #include "CliSupport.h"
 #include "Evaluation/ContourOverlay.h"
 #include "InitialPose/LandmarkPoseEstimator.h"
-#include "IO/Project/LandmarkFile.h"
+#include "IO/Project/LandmarkPairFile.h"
 #include "IO/Project/PoseFile.h"
-#include "IO/Project/ViewFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
-#include "IO/Xray/XrayLoader.h"
 #include "Registration/Registration.h"
-#include "Registration/RegistrationStagesJson.h"
+#include "Registration/RegistrationResultJson.h"
+#include "Registration/RegistrationViewLoader.h"
 
 namespace fct::cli {
 
@@ -54,20 +51,6 @@ struct Options {
   RegistrationAblation ablation;
 };
 
-std::atomic<bool> g_cancel{false};
-extern "C" void onInterrupt(int) { g_cancel.store(true); }
-
-Result<XrayImage> readImage(const ViewSpec& view) {
-  if (view.imagePath.empty()) {
-    return fail(fmt::format("view '{}' has no image; registration needs an X-ray per view (key \"image\" of the view "
-                            "file)",
-                            view.name));
-  }
-  auto image = XrayLoader::load(view.imagePath, view.frame);
-  if (!image) return fail(fmt::format("view '{}': {}", view.name, image.error()));
-  return image;
-}
-
 /// Writes a validity mask as an 8-bit-range PNG (white = compared, black = excluded), creating the folder.
 Status writeMaskPng(const ValidMask& mask, const fs::path& path) {
   std::error_code ec;
@@ -77,46 +60,14 @@ Status writeMaskPng(const ValidMask& mask, const fs::path& path) {
   return ImageFileWriter::writePng16(image, path, 0.0f, 1.0f);
 }
 
-/// The initial pose from --init or --landmarks, and a JSON description of where it came from.
-Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const Options& o,
-                                                                         const std::vector<ViewSpec>& views) {
-  if (!o.init.empty()) {
-    auto pose = PoseFile::read(o.init);
-    if (!pose) return fail(pose.error());
-    return std::make_pair(pose.value(), nlohmann::ordered_json{{"source", "pose file"}, {"path", o.init}});
-  }
-  auto document = JsonDocument::parse(o.landmarks);
-  if (!document) return fail(document.error());
-  JsonReader reader(document.value(), o.landmarks);
-  const std::string ctFile = reader.string("ct");
-  const std::string imageFile = reader.string("image");
-  std::string method = "reprojection";
-  if (reader.has("method")) method = reader.string("method");
-  if (reader.ok() && method != "reprojection" && method != "triangulation") {
-    reader.rejectKey("method", fmt::format("is '{}'; use 'reprojection' or 'triangulation'", method));
-  }
-  if (!reader.ok()) return fail(reader.error());
-  const fs::path folder = fs::path(o.landmarks).parent_path();
-  auto ctLandmarks = LandmarkFile::readCt(folder / ctFile);
-  if (!ctLandmarks) return fail(ctLandmarks.error());
-  auto imageLandmarks = LandmarkFile::readImage(folder / imageFile);
-  if (!imageLandmarks) return fail(imageLandmarks.error());
-  std::map<std::string, Camera> cameras;
-  for (const ViewSpec& view : views) cameras.emplace(view.name, view.camera);
-  for (const auto& [viewName, clicks] : imageLandmarks.value()) {
-    if (!cameras.count(viewName)) {
-      std::vector<std::string> names;
-      for (const ViewSpec& view : views) names.push_back(view.name);
-      return fail(fmt::format("{}: landmarks are clicked in view '{}', which the view file does not have (views: {}); "
-                              "the landmark and view files must name the same views",
-                              (folder / imageFile).string(), viewName, fmt::join(names, ", ")));
-    }
-  }
-  const Landmarks landmarks{ctLandmarks.value(), imageLandmarks.value()};
-  auto estimate = method == "triangulation" ? LandmarkPoseEstimator::fromTriangulation(landmarks, cameras)
-                                            : LandmarkPoseEstimator::fromReprojection(landmarks, cameras);
-  if (!estimate) return fail("initial pose from landmarks: " + estimate.error());
-  const LandmarkPoseEstimate& e = estimate.value();
+/// The initial pose and, for RESULT.json, where it came from.
+struct InitialPose {
+  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();
+  nlohmann::ordered_json source;
+};
+
+/// The residuals of a landmark estimate as RESULT.json lists them.
+nlohmann::ordered_json residualsJson(const LandmarkPoseEstimate& e) {
   nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
   for (const LandmarkResidual& r : e.residuals) {
     nlohmann::ordered_json perView = nlohmann::ordered_json::object();
@@ -125,38 +76,87 @@ Result<std::pair<Eigen::Isometry3d, nlohmann::ordered_json>> initialPose(const O
     if (std::isfinite(r.distance_mm)) entry["distance_mm"] = r.distance_mm;
     residuals.push_back(std::move(entry));
   }
+  return residuals;
+}
+
+/// The initial pose estimated from the landmark pair file `path` with the views' cameras.
+Result<InitialPose> poseFromLandmarks(const std::string& path, const std::vector<RegistrationView>& views) {
+  auto pairs = LandmarkPairFile::read(path);
+  if (!pairs) return fail("--landmarks: " + pairs.error());
+  for (const std::string& warning : pairs.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  const LandmarkPairSet& set = pairs.value();
+  std::map<std::string, Camera> cameras;
+  for (const RegistrationView& view : views) cameras.emplace(view.name, view.camera);
+  for (const auto& [viewName, clicks] : set.landmarks.imageByView) {
+    if (!cameras.count(viewName)) {
+      std::vector<std::string> names;
+      for (const RegistrationView& view : views) names.push_back(view.name);
+      return fail(fmt::format("{}: landmarks are clicked in view '{}', which the view file does not have (views: {}); "
+                              "the landmark and view files must name the same views",
+                              set.imageFile.string(), viewName, fmt::join(names, ", ")));
+    }
+  }
+  auto estimate = set.method == LandmarkPoseMethod::Triangulation
+                      ? LandmarkPoseEstimator::fromTriangulation(set.landmarks, cameras)
+                      : LandmarkPoseEstimator::fromReprojection(set.landmarks, cameras);
+  if (!estimate) return fail("initial pose from landmarks: " + estimate.error());
+  const LandmarkPoseEstimate& e = estimate.value();
   nlohmann::ordered_json source{{"source", "landmarks"},
-                                {"path", o.landmarks},
+                                {"path", path},
                                 {"method", e.method},
                                 {"rms_reprojection_px", e.rmsReprojection_px}};
   if (std::isfinite(e.rms3d_mm)) source["rms_3d_mm"] = e.rms3d_mm;
-  source["residuals"] = std::move(residuals);
-  return std::make_pair(e.T_world_from_ct, std::move(source));
+  source["residuals"] = residualsJson(e);
+  return InitialPose{e.T_world_from_ct, std::move(source)};
 }
 
-nlohmann::ordered_json resultJson(const RegistrationResult& r, const Options& o, nlohmann::ordered_json initial,
-                                  nlohmann::ordered_json transgraph) {
-  initial["T_world_from_ct"] = JsonDocument::array(r.T_initial.matrix());
-  return nlohmann::ordered_json{
-      {"T_world_from_ct", JsonDocument::array(r.T_world_from_ct.matrix())},
-      {"cancelled", r.cancelled},
-      {"initial_pose", std::move(initial)},
-      {"stages", RegistrationStagesJson::write(r)},
-      {"total_seconds", r.totalSeconds},
-      {"total_drrs", r.totalDrrs},
-      {"transgraph", std::move(transgraph)},
-      {"rotation_centre_ct_mm", JsonDocument::array(r.rotationCentre_ct_mm)},
-      {"options",
-       {{"ct", o.ct},
-        {"views", o.views},
-        {"preset", o.preset},
-        {"seed", o.seed},
-        {"method", r.drrMethod},
-        {"ablation", o.ablation.activeNames()},
-        {"field_of_view_detection", !o.noFieldOfView},
-        {"metal_mask", !o.noMetalMask},
-        {"metal_min_excess", o.metalMinExcess},
-        {"schedule", r.schedule.toJson()}}}};
+/// The initial pose from --init or --landmarks.
+Result<InitialPose> initialPose(const Options& o, const std::vector<RegistrationView>& views) {
+  if (o.init.empty()) return poseFromLandmarks(o.landmarks, views);
+  auto pose = PoseFile::read(o.init);
+  if (!pose) return fail("--init: " + pose.error());
+  return InitialPose{pose.value(), nlohmann::ordered_json{{"source", "pose file"}, {"path", o.init}}};
+}
+
+/// Everything register reads before it prepares the case.
+struct Inputs {
+  DrrMethod method = DrrMethod::Siddon;
+  RegistrationSchedule schedule;
+  std::vector<RegistrationView> views;
+  InitialPose initial;
+  std::optional<Eigen::Isometry3d> T_truth;
+  Volume ct;
+};
+
+/// Checks the options and reads the views, the initial pose, the truth and the CT; warnings go to stderr.
+Result<Inputs> readInputs(const Options& o) {
+  if (o.init.empty() == o.landmarks.empty()) {
+    return fail("give the initial pose with exactly one of --init POSE.json or --landmarks LM.json");
+  }
+  Inputs in;
+  auto method = DrrRendererFactory::parseMethod(o.method);
+  if (!method) return fail(method.error());
+  in.method = method.value();
+  auto schedule = RegistrationSchedule::resolve(o.preset);
+  if (!schedule) return fail(schedule.error());
+  in.schedule = std::move(schedule).value();
+  auto views = RegistrationViewLoader::load(o.views);
+  if (!views) return fail("--views: " + views.error());
+  for (const std::string& warning : views.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  in.views = std::move(views).value();
+  auto initial = initialPose(o, in.views);
+  if (!initial) return fail(initial.error());
+  in.initial = std::move(initial).value();
+  if (!o.truth.empty()) {
+    auto truth = PoseFile::read(o.truth);
+    if (!truth) return fail("--truth: " + truth.error());
+    in.T_truth = truth.value();
+  }
+  auto ct = CtLoader::load(o.ct);
+  if (!ct) return fail("--ct: " + ct.error());
+  for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  in.ct = std::move(ct).value();
+  return in;
 }
 
 /// Draws a one-line progress bar on stderr, at most every 100 ms.
@@ -182,151 +182,200 @@ class ProgressBar {
   bool m_drawn = false;
 };
 
-int runRegister(const Options& o) {
-  if (o.init.empty() == o.landmarks.empty()) {
-    return reportError("give the initial pose with exactly one of --init POSE.json or --landmarks LM.json");
-  }
-  auto method = DrrRendererFactory::parseMethod(o.method);
-  if (!method) return reportError(method.error());
-  auto schedule = RegistrationSchedule::resolve(o.preset);
-  if (!schedule) return reportError(schedule.error());
-  auto viewSpecs = ViewFile::read(o.views);
-  if (!viewSpecs) return reportError(viewSpecs.error());
-  auto initial = initialPose(o, viewSpecs.value());
-  if (!initial) return reportError(initial.error());
-  std::optional<Eigen::Isometry3d> T_truth;
-  if (!o.truth.empty()) {
-    auto truth = PoseFile::read(o.truth);
-    if (!truth) return reportError(truth.error());
-    T_truth = truth.value();
-  }
-  auto ct = CtLoader::load(o.ct);
-  if (!ct) return reportError(ct.error());
-  for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
-
-  std::vector<RegistrationView> views;
-  for (const ViewSpec& spec : viewSpecs.value()) {
-    auto image = readImage(spec);
-    if (!image) return reportError(image.error());
-    RegistrationView view{spec.name, std::move(image).value(), spec.camera, {}};
-    for (const PixelCircle& sphere : spec.calibrationSpheres) {
-      view.spheres.push_back(PixelCircle{sphere.centre_px, sphere.radius_px});
-    }
-    views.push_back(std::move(view));
-  }
-  RegistrationCaseOptions caseOptions;
-  caseOptions.drr.method = method.value();
-  caseOptions.drr.transgraph.spacing_mm = o.transgraphSpacing_mm;
+/// The case options of the command: DRR method and Transgraph tables (built around the initial pose unless switched
+/// off), field-of-view and metal exclusions.
+RegistrationCaseOptions caseOptionsFor(const Options& o, const Inputs& in) {
+  RegistrationCaseOptions options;
+  options.drr.method = in.method;
+  options.drr.transgraph.spacing_mm = o.transgraphSpacing_mm;
   if (o.transgraphCache == "none") {
-    caseOptions.drr.transgraphCacheFolder = std::nullopt;
+    options.drr.transgraphCacheFolder = std::nullopt;
   } else {
-    caseOptions.drr.transgraphCacheFolder = fs::path(o.transgraphCache);
+    options.drr.transgraphCacheFolder = fs::path(o.transgraphCache);
   }
-  // The tables are built around the initial pose, unless the Transgraph is switched off for this run.
-  if (!o.ablation.noTransgraph) caseOptions.T_expected_world_from_ct = initial.value().first;
-  caseOptions.preparation.detectFieldOfView = !o.noFieldOfView;
-  caseOptions.preparation.excludeMetal = !o.noMetalMask;
-  caseOptions.preparation.metal.minExcess = o.metalMinExcess;
-  g_cancel = false;
-  const auto previousHandler = std::signal(SIGINT, onInterrupt);
+  if (!o.ablation.noTransgraph) options.T_expected_world_from_ct = in.initial.T_world_from_ct;
+  options.preparation.detectFieldOfView = !o.noFieldOfView;
+  options.preparation.excludeMetal = !o.noMetalMask;
+  options.preparation.metal.minExcess = o.metalMinExcess;
+  return options;
+}
+
+/// Prepares the registration case (X-ray pyramids, masks, Transgraph tables), with table progress on stderr under
+/// --progress; warnings go to stderr.
+Result<RegistrationCase> prepareCase(const Options& o, const Inputs& in, const RegistrationCaseOptions& options,
+                                     const std::atomic<bool>* cancel) {
   ProgressMonitor::Callback onTableProgress;
   if (o.progress) {
     onTableProgress = [](const ProgressUpdate& u) {
       fmt::print(stderr, "\r{}: {:3.0f}% {:<40}", u.stage, 100.0 * u.fraction, u.message);
     };
   }
-  auto registrationCase =
-      RegistrationCase::create(ct.value(), views, caseOptions, ProgressMonitor(onTableProgress, &g_cancel));
-  if (onTableProgress && caseOptions.drr.method == DrrMethod::Transgraph) fmt::print(stderr, "\n");
-  if (!registrationCase) {
-    std::signal(SIGINT, previousHandler);
-    return reportError(registrationCase.error());
-  }
+  auto registrationCase = RegistrationCase::create(in.ct, in.views, options, ProgressMonitor(onTableProgress, cancel));
+  if (onTableProgress && options.drr.method == DrrMethod::Transgraph) fmt::print(stderr, "\n");
   for (const std::string& warning : registrationCase.warnings()) fmt::print(stderr, "warning: {}\n", warning);
-  nlohmann::ordered_json transgraphJson = nullptr;
-  if (registrationCase.value().transgraph(0)) {
-    transgraphJson = {{"setup_seconds", registrationCase.value().viewRendererSetupSeconds()}, {"views", nlohmann::ordered_json::object()}};
-    for (std::size_t v = 0; v < registrationCase.value().viewCount(); ++v) {
-      const Transgraph& table = registrationCase.value().transgraph(v)->transgraph();
-      transgraphJson["views"][registrationCase.value().viewName(v)] = {
-          {"rays", table.rayCount()},
-          {"memory_bytes", table.memory_bytes()},
-          {"seconds", table.buildInfo().build_s},
-          {"loaded_from_cache", table.buildInfo().loadedFromCache},
-          {"cache_file", table.buildInfo().cacheFile.string()}};
-      fmt::print("transgraph {:<10} {:6.1f} M rays, {:5.0f} MB, {} in {:.2f} s\n", registrationCase.value().viewName(v),
-                 table.rayCount() / 1e6, table.memory_bytes() / 1e6,
-                 table.buildInfo().loadedFromCache ? "loaded from the cache" : "built", table.buildInfo().build_s);
-    }
-  }
-  nlohmann::ordered_json metalFractions = nlohmann::ordered_json::object();
-  for (std::size_t v = 0; v < registrationCase.value().viewCount(); ++v) {
-    const PreparedXray& prepared = registrationCase.value().prepared(v);
-    metalFractions[registrationCase.value().viewName(v)] = prepared.metalFraction;
-    if (!o.noMetalMask) {
-      fmt::print("view {}: metal mask excludes {:.2f} % of the field\n", registrationCase.value().viewName(v),
-                 100.0 * prepared.metalFraction);
-    }
-    if (!o.masks.empty()) {
-      const Status written = writeMaskPng(prepared.pyramid.level(0).mask,
-                                          fs::path(o.masks) / (registrationCase.value().viewName(v) + "_mask.png"));
-      if (!written) return reportError(written.error());
-    }
-  }
+  return registrationCase;
+}
 
+/// The case's Transgraph tables for RESULT.json (null without tables), each also printed as one line.
+nlohmann::ordered_json transgraphReport(const RegistrationCase& c) {
+  if (!c.transgraph(0)) return nullptr;
+  nlohmann::ordered_json report{{"setup_seconds", c.viewRendererSetupSeconds()},
+                                {"views", nlohmann::ordered_json::object()}};
+  for (std::size_t v = 0; v < c.viewCount(); ++v) {
+    const Transgraph& table = c.transgraph(v)->transgraph();
+    report["views"][c.viewName(v)] = {{"rays", table.rayCount()},
+                                      {"memory_bytes", table.memory_bytes()},
+                                      {"seconds", table.buildInfo().build_s},
+                                      {"loaded_from_cache", table.buildInfo().loadedFromCache},
+                                      {"cache_file", table.buildInfo().cacheFile.string()}};
+    fmt::print("transgraph {:<10} {:6.1f} M rays, {:5.0f} MB, {} in {:.2f} s\n", c.viewName(v), table.rayCount() / 1e6,
+               table.memory_bytes() / 1e6, table.buildInfo().loadedFromCache ? "loaded from the cache" : "built",
+               table.buildInfo().build_s);
+  }
+  return report;
+}
+
+/// Each view's fraction of the field excluded as metal, for RESULT.json; printed unless --no-metal-mask.
+nlohmann::ordered_json metalReport(const Options& o, const RegistrationCase& c) {
+  nlohmann::ordered_json fractions = nlohmann::ordered_json::object();
+  for (std::size_t v = 0; v < c.viewCount(); ++v) {
+    fractions[c.viewName(v)] = c.prepared(v).metalFraction;
+    if (!o.noMetalMask) {
+      fmt::print("view {}: metal mask excludes {:.2f} % of the field\n", c.viewName(v),
+                 100.0 * c.prepared(v).metalFraction);
+    }
+  }
+  return fractions;
+}
+
+/// --masks: each view's full-resolution validity mask as <view>_mask.png.
+Status writeMasks(const Options& o, const RegistrationCase& c) {
+  if (o.masks.empty()) return Ok{};
+  for (std::size_t v = 0; v < c.viewCount(); ++v) {
+    const Status written =
+        writeMaskPng(c.prepared(v).pyramid.level(0).mask, fs::path(o.masks) / (c.viewName(v) + "_mask.png"));
+    if (!written) return written;
+  }
+  return Ok{};
+}
+
+/// Runs the schedule from the initial pose, with the progress bar on stderr under --progress.
+Result<RegistrationResult> runRegistration(const Options& o, const Inputs& in, RegistrationCase& registrationCase,
+                                           const std::atomic<bool>* cancel) {
   RegistrationOptions options;
-  options.schedule = schedule.value();
+  options.schedule = in.schedule;
   options.ablation = o.ablation;
   options.seed = o.seed;
   ProgressBar bar;
   RegistrationProgressCallback onProgress;
   if (o.progress) onProgress = [&bar](const RegistrationProgress& p) { bar.update(p); };
-  auto result = Registration::run(registrationCase.value(), initial.value().first, options, onProgress, &g_cancel);
-  std::signal(SIGINT, previousHandler);
+  auto result = Registration::run(registrationCase, in.initial.T_world_from_ct, options, onProgress, cancel);
   bar.finish();
-  if (!result) return reportError(result.error());
-  const RegistrationResult& r = result.value();
+  return result;
+}
 
-  if (!o.overlays.empty()) {
-    auto overlay = ContourOverlay::create(ct.value(), caseOptions.boneThreshold_hu);
-    if (!overlay) return reportError("overlays: " + overlay.error());
-    std::error_code ec;
-    fs::create_directories(o.overlays, ec);
-    if (ec) return reportError(fmt::format("cannot create the overlay folder '{}': {}", o.overlays, ec.message()));
-    for (const RegistrationView& view : views) {
-      const Status written = overlay.value().writeOverlayPng(view.xray, view.camera, r.T_initial, r.T_world_from_ct,
-                                                             fs::path(o.overlays) / (view.name + ".png"));
-      if (!written) return reportError(fmt::format("overlay of view '{}': {}", view.name, written.error()));
-    }
+/// --overlays: one PNG per view with the bone outlines at the initial and the registered pose.
+Status writeOverlays(const Options& o, const Inputs& in, double boneThreshold_hu, const RegistrationResult& r) {
+  if (o.overlays.empty()) return Ok{};
+  auto overlay = ContourOverlay::create(in.ct, boneThreshold_hu);
+  if (!overlay) return fail("overlays: " + overlay.error());
+  std::error_code ec;
+  fs::create_directories(o.overlays, ec);
+  if (ec) return fail(fmt::format("cannot create the overlay folder '{}': {}", o.overlays, ec.message()));
+  for (const RegistrationView& view : in.views) {
+    const Status written = overlay.value().writeOverlayPng(view.xray, view.camera, r.T_initial, r.T_world_from_ct,
+                                                           fs::path(o.overlays) / (view.name + ".png"));
+    if (!written) return fail(fmt::format("overlay of view '{}': {}", view.name, written.error()));
   }
-  nlohmann::ordered_json json = resultJson(r, o, initial.value().second, std::move(transgraphJson));
-  if (!o.noMetalMask) json["metal_fraction"] = std::move(metalFractions);
-  std::string errorLine;
-  if (T_truth && registrationCase.value().bone()) {
-    // The pose error as the paper measures it: mean (max) distance of the bone surface points, final vs. truth.
-    const BoneSurface& bone = *registrationCase.value().bone();
-    const double initialMean = bone.meanDistance_mm(r.T_initial, *T_truth);
-    const double finalMean = bone.meanDistance_mm(r.T_world_from_ct, *T_truth);
-    const double finalMax = bone.maxDistance_mm(r.T_world_from_ct, *T_truth);
-    json["error_vs_truth"] = {{"initial_mean_surface_mm", initialMean},
-                              {"final_mean_surface_mm", finalMean},
-                              {"final_max_surface_mm", finalMax}};
-    errorLine = fmt::format("pose error vs truth: mean bone-surface distance {:.3f} mm -> {:.3f} mm (max {:.3f} mm)\n",
-                            initialMean, finalMean, finalMax);
+  return Ok{};
+}
+
+/// The pose error against the truth as the paper measures it: mean (max) bone-surface distance, initial and final.
+struct TruthError {
+  double initialMean_mm = 0.0;
+  double finalMean_mm = 0.0;
+  double finalMax_mm = 0.0;
+};
+
+/// The pose error against --truth; nullopt without --truth or when the CT has no bone surface.
+std::optional<TruthError> truthError(const Inputs& in, const RegistrationCase& c, const RegistrationResult& r) {
+  if (!in.T_truth || !c.bone()) return std::nullopt;
+  const BoneSurface& bone = *c.bone();
+  return TruthError{bone.meanDistance_mm(r.T_initial, *in.T_truth),
+                    bone.meanDistance_mm(r.T_world_from_ct, *in.T_truth),
+                    bone.maxDistance_mm(r.T_world_from_ct, *in.T_truth)};
+}
+
+/// RESULT.json: the result object (RegistrationResultJson) with where the initial pose came from, the command's
+/// options, the Transgraph tables, the metal fractions (unless --no-metal-mask) and the error against --truth added.
+nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r, nlohmann::ordered_json initialSource,
+                                  nlohmann::ordered_json transgraph, nlohmann::ordered_json metal,
+                                  const std::optional<TruthError>& error) {
+  nlohmann::ordered_json json = RegistrationResultJson::write(r);
+  for (const auto& item : json["initial_pose"].items()) initialSource[item.key()] = item.value();
+  json["initial_pose"] = std::move(initialSource);
+  nlohmann::ordered_json options{{"ct", o.ct},
+                                 {"views", o.views},
+                                 {"preset", o.preset},
+                                 {"seed", o.seed},
+                                 {"ablation", o.ablation.activeNames()},
+                                 {"field_of_view_detection", !o.noFieldOfView},
+                                 {"metal_mask", !o.noMetalMask},
+                                 {"metal_min_excess", o.metalMinExcess}};
+  for (const auto& item : json["options"].items()) options[item.key()] = item.value();
+  json["options"] = std::move(options);
+  json["transgraph"] = std::move(transgraph);
+  if (!o.noMetalMask) json["metal_fraction"] = std::move(metal);
+  if (error) {
+    json["error_vs_truth"] = {{"initial_mean_surface_mm", error->initialMean_mm},
+                              {"final_mean_surface_mm", error->finalMean_mm},
+                              {"final_max_surface_mm", error->finalMax_mm}};
   }
-  if (!o.out.empty()) {
-    const Status written = JsonDocument::write(json, o.out);
-    if (!written) return reportError(written.error());
-  }
+  return json;
+}
+
+/// Prints one line per stage, the summary line and the error against the truth.
+void printResult(const Options& o, const RegistrationResult& r, const std::optional<TruthError>& error) {
   for (const StageReport& s : r.stages) {
     fmt::print("stage {:<16} {:>4} level {} {:<7} {:7.2f} s {:7} DRRs  similarity {:.4f} -> {:.4f}{}{}\n", s.name,
-               s.metric, s.level, s.search, s.seconds, s.drrs, s.startSimilarity, s.similarity,
+               RegistrationSchedule::metricName(s.metric), s.level, RegistrationSchedule::searchName(s.search),
+               s.seconds, s.drrs, s.startSimilarity, s.similarity,
                s.fallbackRays ? fmt::format("  ({} rays outside the Transgraph, exact)", s.fallbackRays) : "",
                s.cancelled ? " (cancelled)" : "");
   }
   fmt::print("{} in {:.2f} s, {} DRRs ({} method){}\n", r.cancelled ? "cancelled" : "registered", r.totalSeconds,
              r.totalDrrs, r.drrMethod, o.out.empty() ? "" : fmt::format("; wrote {}", o.out));
-  fmt::print("{}", errorLine);
+  if (error) {
+    fmt::print("pose error vs truth: mean bone-surface distance {:.3f} mm -> {:.3f} mm (max {:.3f} mm)\n",
+               error->initialMean_mm, error->finalMean_mm, error->finalMax_mm);
+  }
+}
+
+int runRegister(const Options& o) {
+  auto inputs = readInputs(o);
+  if (!inputs) return reportError(inputs.error());
+  const Inputs& in = inputs.value();
+  const RegistrationCaseOptions caseOptions = caseOptionsFor(o, in);
+  const InterruptGuard interrupt;  // Ctrl-C cancels the table builds and the registration
+  auto registrationCase = prepareCase(o, in, caseOptions, InterruptGuard::cancelFlag());
+  if (!registrationCase) return reportError(registrationCase.error());
+  nlohmann::ordered_json transgraph = transgraphReport(registrationCase.value());
+  nlohmann::ordered_json metal = metalReport(o, registrationCase.value());
+  if (Status written = writeMasks(o, registrationCase.value()); !written) return reportError(written.error());
+
+  auto result = runRegistration(o, in, registrationCase.value(), InterruptGuard::cancelFlag());
+  if (!result) return reportError(result.error());
+  const RegistrationResult& r = result.value();
+  if (Status written = writeOverlays(o, in, caseOptions.boneThreshold_hu, r); !written) {
+    return reportError(written.error());
+  }
+  const std::optional<TruthError> error = truthError(in, registrationCase.value(), r);
+  if (!o.out.empty()) {
+    const Status written =
+        JsonDocument::write(resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal), error), o.out);
+    if (!written) return reportError(written.error());
+  }
+  printResult(o, r, error);
   return 0;
 }
 

@@ -47,6 +47,16 @@ std::string JsonReader::string(std::string_view key) {
   return text;
 }
 
+bool JsonReader::boolean(std::string_view key) {
+  const nlohmann::json* value = required(key);
+  if (!value) return false;
+  if (!value->is_boolean()) {
+    rejectKey(key, fmt::format("must be true or false, got {}", describe(*value)));
+    return false;
+  }
+  return value->get<bool>();
+}
+
 double JsonReader::numberAt(const nlohmann::json& value, std::string_view key) {
   if (!value.is_number()) {
     rejectKey(key, fmt::format("must be a number, got {}", describe(value)));

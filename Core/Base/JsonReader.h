@@ -25,6 +25,8 @@ class JsonReader {
 
   /// A required non-empty string; "" after an error.
   std::string string(std::string_view key);
+  /// A required true or false; false after an error.
+  bool boolean(std::string_view key);
   /// A required finite number; 0 after an error.
   double number(std::string_view key);
   /// A required finite number > 0; 0 after an error.

@@ -108,9 +108,9 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
 
     StageReport report;
     report.name = stage.name;
-    report.metric = std::string(RegistrationSchedule::metricName(stage.metric));
+    report.metric = stage.metric;
     report.level = stage.level;
-    report.search = std::string(RegistrationSchedule::searchName(stage.search));
+    report.search = stage.search;
     report.startSimilarity = startValue.value();
     report.keptFraction = objective.keptFractions();
 

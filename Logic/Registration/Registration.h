@@ -47,9 +47,9 @@ using RegistrationProgressCallback = std::function<void(const RegistrationProgre
 /// What one stage did.
 struct StageReport {
   std::string name;
-  std::string metric;              ///< "ncc", "vlnc", "gc"
-  int level = 0;
-  std::string search;              ///< "genetic", "cmaes", "local"
+  SimilarityMetric metric = SimilarityMetric::Ncc;
+  int level = 0;                   ///< pyramid level: 0 = full resolution
+  SearchStrategy search = SearchStrategy::Local;
   double seconds = 0.0;
   long drrs = 0;                   ///< DRRs rendered in the stage (evaluations x views)
   long fallbackRays = 0;           ///< Transgraph rays outside their table, integrated exactly (0 for other methods)

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <optional>
+
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
 #include "RegistrationPresetsEmbedded.h"
@@ -12,15 +14,31 @@ namespace fct {
 namespace {
 
 template <typename Enum, std::size_t N>
-Enum parseName(JsonReader& reader, std::string_view key, const std::array<std::pair<std::string_view, Enum>, N>& names) {
-  const std::string text = reader.string(key);
-  if (!reader.ok()) return names[0].second;
+using NameTable = std::array<std::pair<std::string_view, Enum>, N>;
+
+/// The value named `text`, or nullopt.
+template <typename Enum, std::size_t N>
+std::optional<Enum> valueNamed(std::string_view text, const NameTable<Enum, N>& names) {
   for (const auto& [name, value] : names) {
     if (text == name) return value;
   }
+  return std::nullopt;
+}
+
+/// The names of a table, comma-separated.
+template <typename Enum, std::size_t N>
+std::string namesOf(const NameTable<Enum, N>& names) {
   std::vector<std::string_view> accepted;
   for (const auto& entry : names) accepted.push_back(entry.first);
-  reader.rejectKey(key, fmt::format("is '{}'; use one of {}", text, fmt::join(accepted, ", ")));
+  return fmt::format("{}", fmt::join(accepted, ", "));
+}
+
+template <typename Enum, std::size_t N>
+Enum parseName(JsonReader& reader, std::string_view key, const NameTable<Enum, N>& names) {
+  const std::string text = reader.string(key);
+  if (!reader.ok()) return names[0].second;
+  if (const std::optional<Enum> value = valueNamed(text, names)) return *value;
+  reader.rejectKey(key, fmt::format("is '{}'; use one of {}", text, namesOf(names)));
   return names[0].second;
 }
 
@@ -147,6 +165,16 @@ std::vector<std::string> RegistrationAblation::activeNames() const {
 
 std::string_view RegistrationSchedule::metricName(SimilarityMetric metric) { return nameOf(metric, kMetrics); }
 std::string_view RegistrationSchedule::searchName(SearchStrategy search) { return nameOf(search, kSearches); }
+
+Result<SimilarityMetric> RegistrationSchedule::parseMetric(std::string_view name) {
+  if (const auto metric = valueNamed(name, kMetrics)) return *metric;
+  return fail(fmt::format("'{}' is not a similarity metric; use one of {}", name, namesOf(kMetrics)));
+}
+
+Result<SearchStrategy> RegistrationSchedule::parseSearch(std::string_view name) {
+  if (const auto search = valueNamed(name, kSearches)) return *search;
+  return fail(fmt::format("'{}' is not a search strategy; use one of {}", name, namesOf(kSearches)));
+}
 
 std::vector<std::string> RegistrationSchedule::builtinNames() {
   std::vector<std::string> names;

@@ -102,6 +102,10 @@ class RegistrationSchedule {
   static std::string_view metricName(SimilarityMetric metric);
   /// Lowercase name of a strategy ("genetic", "cmaes", "local").
   static std::string_view searchName(SearchStrategy search);
+  /// The metric of a metricName(); fails naming the text and the accepted names.
+  static Result<SimilarityMetric> parseMetric(std::string_view name);
+  /// The strategy of a searchName(); fails naming the text and the accepted names.
+  static Result<SearchStrategy> parseSearch(std::string_view name);
 
   std::string name;
   std::string description;

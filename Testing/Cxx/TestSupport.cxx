@@ -17,6 +17,8 @@ std::filesystem::path dataDir() {
 
 bool hasData(const std::string& relative) { return std::filesystem::exists(dataDir() / relative); }
 
+std::filesystem::path fixtureDir() { return FCT_FIXTURE_DIR; }
+
 std::filesystem::path scratchDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? fmt::format("{}_{}", info->test_suite_name(), info->name()) : "fct_test";

@@ -10,6 +10,8 @@ namespace fct::test {
 std::filesystem::path dataDir();
 /// True if dataDir()/relative exists.
 bool hasData(const std::string& relative);
+/// The small files kept in the repository for the tests (Testing/Data), e.g. files written by earlier versions.
+std::filesystem::path fixtureDir();
 /// A fresh, empty scratch folder unique to the running test (removed and recreated on each call).
 std::filesystem::path scratchDir();
 /// Path of the built `fluoroct` command-line program.

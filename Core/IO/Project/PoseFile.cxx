@@ -12,12 +12,22 @@ Result<Eigen::Isometry3d> PoseFile::read(const std::filesystem::path& path) {
   auto document = JsonDocument::parse(path);
   if (!document) return fail(document.error());
   JsonReader reader(document.value(), path.string());
-  const Eigen::Matrix4d matrix = reader.matrix("T_world_from_ct", 4, 4);
-  if (!reader.ok()) return fail(reader.error());
-  auto pose = RigidPose::validated(matrix, "T_world_from_ct");
-  if (!pose) return fail(fmt::format("{}: {}", path.string(), pose.error()));
+  const std::optional<Eigen::Isometry3d> T_world_from_ct = readKey(reader, "T_world_from_ct");
+  if (!T_world_from_ct) return fail(reader.error());
+  Result<Eigen::Isometry3d> pose(*T_world_from_ct);
   for (std::string& warning : reader.unknownKeys({"T_world_from_ct"})) pose.addWarning(std::move(warning));
   return pose;
+}
+
+std::optional<Eigen::Isometry3d> PoseFile::readKey(JsonReader& reader, std::string_view key) {
+  const Eigen::Matrix4d matrix = reader.matrix(key, 4, 4);
+  if (!reader.ok()) return std::nullopt;
+  auto pose = RigidPose::validated(matrix, std::string(key).c_str());
+  if (!pose) {
+    reader.reject(pose.error());
+    return std::nullopt;
+  }
+  return pose.value();
 }
 
 Status PoseFile::write(const Eigen::Isometry3d& T_world_from_ct, const std::filesystem::path& path) {

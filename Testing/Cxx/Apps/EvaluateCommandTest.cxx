@@ -284,6 +284,7 @@ TEST(EvaluateCommand, FullStudyWithoutItsCtsFailsNamingBothWaysToGiveThem) {
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
   }
   EXPECT_FALSE(fs::exists(dir / "out" / "trials.csv"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "setup.txt")) << "a run without its CTs leaves no setup behind";
 }
 
 TEST(EvaluateCommand, FullStudyTakesItsCtFromTheDataFolderNamedByTheEnvironment) {

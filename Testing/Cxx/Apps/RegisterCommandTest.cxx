@@ -11,6 +11,7 @@
 #include "IO/Project/LandmarkFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
+#include "Registration/RegistrationResultJson.h"
 #include "TestSupport.h"
 
 namespace {
@@ -98,6 +99,29 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
     EXPECT_TRUE(fs::exists(dir / "masks" / (std::string(view) + "_mask.png"))) << view;
     EXPECT_LT(json["metal_fraction"][view].get<double>(), 0.05) << "the phantom has no metal: " << view;
   }
+}
+
+TEST(RegisterCommand, ResultFileReadsBackAsARegistrationResult) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
+  const auto run = fct::test::runCli(fmt::format("register --ct '{}' --views '{}' --init '{}' --preset fast --local-only "
+                                                 "--out '{}'",
+                                                 (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(),
+                                                 (dir / "init.json").string(), (dir / "result.json").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  auto json = fct::JsonDocument::parse(dir / "result.json");
+  ASSERT_TRUE(json.ok()) << json.error();
+  EXPECT_EQ(json.value()["format"], fct::RegistrationResultJson::kFormat);
+  auto result = fct::RegistrationResultJson::read(json.value(), "result.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  EXPECT_TRUE(result.value().T_initial.isApprox(perturbed(truth), 1e-12));
+  EXPECT_EQ(result.value().viewNames, (std::vector<std::string>{"ap", "lateral", "oblique45"}));
+  EXPECT_EQ(result.value().stages.size(), 4u);
+  EXPECT_EQ(result.value().drrMethod, "siddon");
+  auto pose = fct::PoseFile::read(dir / "result.json");
+  ASSERT_TRUE(pose.ok()) << pose.error();
+  EXPECT_TRUE(pose.value().isApprox(result.value().T_world_from_ct, 1e-12));
 }
 
 TEST(RegisterCommand, EstimatesTheInitialPoseFromLandmarks) {

@@ -2,6 +2,8 @@
 
 #include <fstream>
 
+#include "Base/JsonDocument.h"
+#include "Registration/RegistrationResultJson.h"
 #include "StudioDocument.h"
 #include "StudioSession.h"
 #include "StudioTestCase.h"
@@ -45,9 +47,9 @@ void fillDocument(StudioDocument& d) {
   result.cancelled = true;
   fct::StageReport stage;
   stage.name = "coarse";
-  stage.metric = "ncc";
+  stage.metric = fct::SimilarityMetric::Ncc;
   stage.level = 2;
-  stage.search = "genetic";
+  stage.search = fct::SearchStrategy::Genetic;
   stage.similarity = 0.75;
   stage.keptFraction = {0.1, 0.2};
   result.stages.push_back(stage);
@@ -108,6 +110,24 @@ TEST(StudioSession, SaveThenOpenGivesTheSameDocument) {
   EXPECT_EQ(reopened.sessionPath(), path);
 }
 
+TEST(StudioSession, SavesTheResultAsTheObjectOfResultFiles) {
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  StudioDocument document;
+  fillDocument(document);
+  const auto path = fct::test::scratchDir() / "case.fctsession.json";
+  ASSERT_TRUE(StudioSession::save(document, path).ok());
+  auto json = fct::JsonDocument::parse(path);
+  ASSERT_TRUE(json.ok()) << json.error();
+  EXPECT_EQ(json.value()["version"], 2);
+  const nlohmann::json& result = json.value()["result"];
+  EXPECT_EQ(result["format"], fct::RegistrationResultJson::kFormat);
+  EXPECT_EQ(result["verdict"], "rejected");
+  auto read = fct::RegistrationResultJson::read(result, "session: result");
+  ASSERT_TRUE(read.ok()) << read.error();
+  EXPECT_TRUE(read.value().T_initial.isApprox(document.result()->T_initial, 1e-12));
+  EXPECT_EQ(read.value().drrMethod, "raycast");
+}
+
 TEST(StudioSession, BadSessionFileLeavesTheDocumentAsItWas) {
   ASSERT_FALSE(fct::test::builtinCaseDir().empty());
   StudioDocument document;
@@ -144,6 +164,46 @@ TEST(StudioSession, AutosaveReopensModifiedAndRemembersItsSessionFile) {
   EXPECT_TRUE(restored.isModified());
   EXPECT_EQ(restored.sessionPath(), folder / "mine.fctsession.json");
   EXPECT_EQ(restored.registrationOptions().seed, 7u);
+}
+
+TEST(StudioSession, OpensASessionFileOfVersion1) {
+  // A session saved by the Studio in version 1 after a registration of the built-in case (Testing/Data/compat); its
+  // CT and view file are named relative to it, so it is opened from a copy of the built-in case folder.
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  const auto folder = fct::test::scratchDir() / "case";
+  std::filesystem::copy(fct::test::builtinCaseDir(), folder, std::filesystem::copy_options::recursive);
+  const auto path = folder / "session-v1.fctsession.json";
+  std::filesystem::copy_file(fct::test::fixtureDir() / "compat" / "session-v1.fctsession.json", path);
+
+  StudioDocument document;
+  const fct::Status opened = StudioSession::open(document, path);
+  ASSERT_TRUE(opened.ok()) << opened.error();
+  ASSERT_TRUE(document.ct());
+  ASSERT_EQ(document.views().size(), 2u);
+  ASSERT_EQ(document.landmarks().ct.size(), 2u);
+  EXPECT_EQ(document.landmarks().ct[1].name, "L2");
+  ASSERT_TRUE(document.initialPose());
+  EXPECT_NEAR(document.initialPose()->translation().x(), 5.256111045732162, 1e-12);
+  EXPECT_EQ(document.registrationOptions(), (fct::StudioRegistrationOptions{"fast", 1, "siddon"}));
+  ASSERT_TRUE(document.result());
+  const fct::RegistrationResult& r = *document.result();
+  EXPECT_NEAR(r.T_world_from_ct.translation().x(), 6.196236763656561, 1e-12);
+  EXPECT_TRUE(r.T_initial.isApprox(*document.initialPose(), 1e-12));
+  EXPECT_NEAR(r.rotationCentre_ct_mm.x(), 14.775599999999951, 1e-12);
+  EXPECT_FALSE(r.cancelled);
+  EXPECT_EQ(r.totalDrrs, 2082);
+  EXPECT_DOUBLE_EQ(r.totalSeconds, 0.176155691);
+  EXPECT_EQ(r.drrMethod, "siddon");
+  EXPECT_EQ(r.viewNames, (std::vector<std::string>{"ap", "lateral"}));
+  ASSERT_EQ(r.stages.size(), 4u);
+  EXPECT_EQ(r.stages[0].name, "ncc-whole-1:16");
+  EXPECT_EQ(r.stages[0].level, 2);
+  EXPECT_EQ(r.stages[3].keptFraction.size(), 2u);
+  EXPECT_EQ(r.schedule.stages.size(), 4u);
+  EXPECT_EQ(document.resultVerdict(), fct::ResultVerdict::Accepted);
+  ASSERT_TRUE(document.truthPose());
+  EXPECT_NEAR(document.truthPose()->translation().x(), 6.029505328528211, 1e-12);
+  EXPECT_FALSE(document.isModified());
 }
 
 }  // namespace

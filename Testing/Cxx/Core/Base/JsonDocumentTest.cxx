@@ -43,3 +43,16 @@ TEST(JsonReader, FirstErrorWinsAndNamesPlaceAndKey) {
   fct::JsonReader notObject(nlohmann::json::array(), "there");
   EXPECT_EQ(notObject.error(), "there: must be a JSON object {...}, got an array of 0 values");
 }
+
+TEST(JsonReader, BooleanAcceptsOnlyTrueOrFalse) {
+  const nlohmann::json object = {{"on", true}, {"off", false}, {"word", "yes"}};
+  fct::JsonReader reader(object, "here");
+  EXPECT_TRUE(reader.boolean("on"));
+  EXPECT_FALSE(reader.boolean("off"));
+  EXPECT_TRUE(reader.ok());
+  EXPECT_FALSE(reader.boolean("word"));
+  EXPECT_EQ(reader.error(), "here: key 'word' must be true or false, got the string \"yes\"");
+  fct::JsonReader missing(object, "there");
+  EXPECT_FALSE(missing.boolean("gone"));
+  EXPECT_EQ(missing.error(), "there: key 'gone' is missing");
+}

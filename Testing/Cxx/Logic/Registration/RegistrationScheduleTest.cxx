@@ -151,3 +151,24 @@ TEST(RegistrationSchedule, RoiPixelsRejectABadWindowOrFraction) {
   ASSERT_FALSE(fraction.ok());
   EXPECT_NE(fraction.error().find("(0, 1]"), std::string::npos);
 }
+
+TEST(RegistrationSchedule, MetricAndSearchNamesParseBackAndUnknownNamesAreRefused) {
+  for (fct::SimilarityMetric metric :
+       {fct::SimilarityMetric::Ncc, fct::SimilarityMetric::Vlnc, fct::SimilarityMetric::GradientCorrelation}) {
+    const auto parsed = fct::RegistrationSchedule::parseMetric(fct::RegistrationSchedule::metricName(metric));
+    ASSERT_TRUE(parsed.ok()) << parsed.error();
+    EXPECT_EQ(parsed.value(), metric);
+  }
+  for (fct::SearchStrategy search :
+       {fct::SearchStrategy::Genetic, fct::SearchStrategy::CmaEs, fct::SearchStrategy::Local}) {
+    const auto parsed = fct::RegistrationSchedule::parseSearch(fct::RegistrationSchedule::searchName(search));
+    ASSERT_TRUE(parsed.ok()) << parsed.error();
+    EXPECT_EQ(parsed.value(), search);
+  }
+  const auto metric = fct::RegistrationSchedule::parseMetric("NCC");
+  ASSERT_FALSE(metric.ok());
+  EXPECT_EQ(metric.error(), "'NCC' is not a similarity metric; use one of ncc, vlnc, gc");
+  const auto search = fct::RegistrationSchedule::parseSearch("");
+  ASSERT_FALSE(search.ok());
+  EXPECT_EQ(search.error(), "'' is not a search strategy; use one of genetic, cmaes, local");
+}

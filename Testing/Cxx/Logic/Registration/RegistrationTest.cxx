@@ -113,8 +113,8 @@ TEST(Registration, ResultReportsEveryStageAndNeverEndsWorseThanItStarted) {
     drrs += stage.drrs;
   }
   EXPECT_EQ(drrs, r.totalDrrs);
-  EXPECT_EQ(r.stages[0].metric, "ncc");
-  EXPECT_EQ(r.stages[1].metric, "vlnc");
+  EXPECT_EQ(r.stages[0].metric, fct::SimilarityMetric::Ncc);
+  EXPECT_EQ(r.stages[1].metric, fct::SimilarityMetric::Vlnc);
   EXPECT_NEAR(r.stages[1].keptFraction[0], 0.15, 0.05) << "dynamic ROIs keep the preset's fraction";
   EXPECT_TRUE(r.T_initial.isApprox(start));
   EXPECT_LT(errorOf(p, r.T_world_from_ct), errorOf(p, start));
@@ -164,7 +164,7 @@ TEST(Registration, EachAblationSwitchStillRuns) {
       EXPECT_GT(result.value().stages[1].keptFraction[0], 0.5);
     }
     if (ablation.cmaesForGenetic) {
-      EXPECT_EQ(result.value().stages[0].search, "cmaes");
+      EXPECT_EQ(result.value().stages[0].search, fct::SearchStrategy::CmaEs);
     }
     EXPECT_LT(errorOf(p, result.value().T_world_from_ct), errorOf(p, start));
   }

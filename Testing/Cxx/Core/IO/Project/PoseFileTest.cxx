@@ -65,3 +65,24 @@ TEST(PoseFile, FailedWriteLeavesTheOldFileUntouched) {
   EXPECT_EQ(fct::TextFile::read(path).value(), before);
   EXPECT_FALSE(fct::PoseFile::write(obliquePose(), path.parent_path() / "missing" / "pose.json").ok());
 }
+
+TEST(PoseFile, ReadsTheRegisteredPoseOfAResultFileOfFormat1) {
+  // A RESULT.json of `fluoroct register` in format 1 (no "format" key), kept in Testing/Data/compat.
+  const auto read = fct::PoseFile::read(fct::test::fixtureDir() / "compat" / "RESULT-v1.json");
+  ASSERT_TRUE(read.ok()) << read.error();
+  EXPECT_NEAR(read.value().translation().x(), 1.928635690899748, 1e-12);
+  EXPECT_NEAR(read.value().translation().z(), 2.4187276194543705, 1e-12);
+  EXPECT_NEAR(read.value().linear()(0, 1), -0.03713716818520369, 1e-12);
+}
+
+TEST(PoseFile, ReadKeyReadsANestedPoseAndRecordsWhatIsWrong) {
+  const nlohmann::json object = {{"initial", {{"T", {{1, 0, 0, 5}, {0, 1, 0, 6}, {0, 0, 1, 7}, {0, 0, 0, 1}}}}},
+                                 {"bad", {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {1, 0, 0, 1}}}};
+  fct::JsonReader reader(object, "x.json");
+  const auto pose = fct::PoseFile::readKey(reader, "initial.T");
+  ASSERT_TRUE(pose) << reader.error();
+  EXPECT_EQ(pose->translation(), Eigen::Vector3d(5, 6, 7));
+  EXPECT_FALSE(fct::PoseFile::readKey(reader, "bad"));
+  EXPECT_EQ(reader.error(), "x.json: bad's last row must be [0, 0, 0, 1]");
+  EXPECT_FALSE(fct::PoseFile::readKey(reader, "initial.T")) << "nothing is read after an error";
+}

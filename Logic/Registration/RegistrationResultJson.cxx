@@ -1,0 +1,207 @@
+#include "Registration/RegistrationResultJson.h"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <string_view>
+
+#include "Base/JsonDocument.h"
+#include "Base/JsonReader.h"
+#include "IO/Project/PoseFile.h"
+
+namespace fct {
+
+namespace {
+
+using ordered_json = nlohmann::ordered_json;
+
+/// Where the keys that differ between the spellings are.
+struct Keys {
+  const char* initialPose;
+  const char* method;
+  const char* schedule;
+};
+constexpr Keys kKeys{"initial_pose.T_world_from_ct", "options.method", "options.schedule"};
+constexpr Keys kSessionVersion1Keys{"T_initial", "drr_method", "schedule"};
+
+/// A required whole number >= 0 that may exceed an int (DRR and ray counts); 0 after an error.
+long count(JsonReader& reader, std::string_view key) {
+  const double value = reader.number(key);
+  if (reader.ok() && (value < 0.0 || value != std::floor(value) || value > 9.0e15)) {
+    reader.rejectKey(key, fmt::format("must be a whole number >= 0, got {}", value));
+  }
+  return reader.ok() ? static_cast<long>(value) : 0;
+}
+
+/// A required string that may be empty (the DRR method of a run cancelled before its first stage).
+std::string text(JsonReader& reader, std::string_view key) {
+  const nlohmann::json* value = reader.find(key);
+  if (reader.ok() && (!value || !value->is_string())) {
+    reader.rejectKey(key, value ? "must be a string, got " + JsonReader::describe(*value) : "is missing");
+  }
+  return reader.ok() ? value->get<std::string>() : std::string();
+}
+
+/// The view names: the `view_names` array, or (version 1 without it) the first stage's kept_fraction keys.
+std::vector<std::string> readViewNames(JsonReader& reader, const nlohmann::json& object, int version) {
+  std::vector<std::string> names;
+  const nlohmann::json* list = reader.find("view_names");
+  if (!list && version == 1) {
+    const auto stages = object.find("stages");
+    if (stages != object.end() && stages->is_array() && !stages->empty() && stages->front().is_object()) {
+      const auto kept = stages->front().find("kept_fraction");
+      if (kept != stages->front().end() && kept->is_object()) {
+        for (const auto& item : kept->items()) names.push_back(item.key());
+      }
+    }
+    return names;
+  }
+  if (!list || !list->is_array()) {
+    reader.rejectKey("view_names", list ? "must be an array of view names, got " + JsonReader::describe(*list)
+                                        : "is missing");
+    return names;
+  }
+  for (const nlohmann::json& name : *list) {
+    if (!name.is_string()) {
+      reader.rejectKey("view_names", "must hold only strings, got " + JsonReader::describe(name));
+      return {};
+    }
+    names.push_back(name.get<std::string>());
+  }
+  return names;
+}
+
+StageReport readStage(const nlohmann::json& object, const std::string& where, const std::vector<std::string>& views,
+                      JsonReader& parent) {
+  JsonReader reader(object, where);
+  StageReport stage;
+  stage.name = reader.string("name");
+  if (const std::string metric = reader.string("metric"); reader.ok()) {
+    if (auto parsed = RegistrationSchedule::parseMetric(metric)) {
+      stage.metric = parsed.value();
+    } else {
+      reader.reject("key 'metric': " + parsed.error());
+    }
+  }
+  stage.level = reader.integer("level", 0);
+  if (const std::string search = reader.string("search"); reader.ok()) {
+    if (auto parsed = RegistrationSchedule::parseSearch(search)) {
+      stage.search = parsed.value();
+    } else {
+      reader.reject("key 'search': " + parsed.error());
+    }
+  }
+  stage.seconds = reader.number("seconds");
+  stage.drrs = count(reader, "drrs");
+  stage.fallbackRays = count(reader, "fallback_rays");
+  stage.evaluations = reader.integer("evaluations", 0);
+  stage.startSimilarity = reader.number("start_similarity");
+  stage.similarity = reader.number("similarity");
+  const nlohmann::json* kept = reader.find("kept_fraction");
+  if (reader.ok() && (!kept || !kept->is_object())) {
+    reader.rejectKey("kept_fraction", kept ? "must be an object {<view name>: fraction}, got " +
+                                                 JsonReader::describe(*kept)
+                                           : "is missing");
+  }
+  for (std::size_t v = 0; reader.ok() && v < views.size(); ++v) {
+    const auto value = kept->find(views[v]);
+    if (value == kept->end()) break;  // the writer leaves out nothing but fractions without a view name
+    if (!value->is_number() || !std::isfinite(value->get<double>())) {
+      reader.rejectKey("kept_fraction", fmt::format("of view '{}' must be a finite number, got {}", views[v],
+                                                    JsonReader::describe(*value)));
+      break;
+    }
+    stage.keptFraction.push_back(value->get<double>());
+  }
+  stage.cancelled = reader.boolean("cancelled");
+  parent.adoptError(reader);
+  return stage;
+}
+
+}  // namespace
+
+ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
+  ordered_json stages = ordered_json::array();
+  for (const StageReport& s : result.stages) {
+    ordered_json kept = ordered_json::object();
+    for (std::size_t v = 0; v < s.keptFraction.size() && v < result.viewNames.size(); ++v) {
+      kept[result.viewNames[v]] = s.keptFraction[v];
+    }
+    stages.push_back({{"name", s.name},
+                      {"metric", RegistrationSchedule::metricName(s.metric)},
+                      {"level", s.level},
+                      {"search", RegistrationSchedule::searchName(s.search)},
+                      {"seconds", s.seconds},
+                      {"drrs", s.drrs},
+                      {"fallback_rays", s.fallbackRays},
+                      {"evaluations", s.evaluations},
+                      {"start_similarity", s.startSimilarity},
+                      {"similarity", s.similarity},
+                      {"kept_fraction", std::move(kept)},
+                      {"cancelled", s.cancelled}});
+  }
+  ordered_json initialPose = ordered_json::object();
+  initialPose["T_world_from_ct"] = JsonDocument::array(result.T_initial.matrix());
+  ordered_json options = ordered_json::object();
+  options["method"] = result.drrMethod;
+  options["schedule"] = result.schedule.toJson();
+  return ordered_json{{"format", kFormat},
+                      {"version", kVersion},
+                      {"T_world_from_ct", JsonDocument::array(result.T_world_from_ct.matrix())},
+                      {"cancelled", result.cancelled},
+                      {"initial_pose", std::move(initialPose)},
+                      {"rotation_centre_ct_mm", JsonDocument::array(result.rotationCentre_ct_mm)},
+                      {"view_names", result.viewNames},
+                      {"stages", std::move(stages)},
+                      {"total_seconds", result.totalSeconds},
+                      {"total_drrs", result.totalDrrs},
+                      {"view_renderer_setup_seconds", result.viewRendererSetupSeconds},
+                      {"options", std::move(options)}};
+}
+
+Result<RegistrationResult> RegistrationResultJson::read(const nlohmann::json& object, const std::string& where) {
+  JsonReader reader(object, where);
+  int version = 1;
+  if (reader.has("format")) {
+    const std::string format = reader.string("format");
+    if (reader.ok() && format != kFormat) {
+      reader.rejectKey("format", fmt::format("is '{}', not '{}': this is not a FluoroCT registration result", format,
+                                             kFormat));
+    }
+    version = reader.integer("version", 1);
+    if (reader.ok() && version > kVersion) {
+      reader.rejectKey("version", fmt::format("is {}; this program reads versions 1 to {} (update FluoroCT)", version,
+                                              kVersion));
+    }
+  }
+  if (!reader.ok()) return fail(reader.error());
+  const Keys& keys = version == 1 && reader.has("T_initial") ? kSessionVersion1Keys : kKeys;
+
+  RegistrationResult r;
+  if (auto T = PoseFile::readKey(reader, "T_world_from_ct")) r.T_world_from_ct = *T;
+  if (auto T = PoseFile::readKey(reader, keys.initialPose)) r.T_initial = *T;
+  r.cancelled = reader.boolean("cancelled");
+  r.rotationCentre_ct_mm = reader.vector("rotation_centre_ct_mm", 3);
+  r.viewNames = readViewNames(reader, object, version);
+  r.totalSeconds = reader.number("total_seconds");
+  r.totalDrrs = count(reader, "total_drrs");
+  if (version >= 2) r.viewRendererSetupSeconds = reader.number("view_renderer_setup_seconds");
+  r.drrMethod = text(reader, keys.method);
+  const nlohmann::json* stages = reader.find("stages");
+  if (reader.ok() && (!stages || !stages->is_array())) {
+    reader.rejectKey("stages", stages ? "must be an array of stage reports, got " + JsonReader::describe(*stages)
+                                      : "is missing");
+  }
+  for (std::size_t i = 0; reader.ok() && i < stages->size(); ++i) {
+    r.stages.push_back(readStage((*stages)[i], fmt::format("{}: stages[{}]", where, i), r.viewNames, reader));
+  }
+  const nlohmann::json* schedule = reader.find(keys.schedule);
+  if (reader.ok() && !schedule) reader.rejectKey(keys.schedule, "is missing");
+  if (!reader.ok()) return fail(reader.error());
+  auto parsed = RegistrationSchedule::fromJson(*schedule, fmt::format("{}: {}", where, keys.schedule));
+  if (!parsed) return fail(parsed.error());
+  r.schedule = std::move(parsed).value();
+  return r;
+}
+
+}  // namespace fct

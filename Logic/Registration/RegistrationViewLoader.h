@@ -1,0 +1,23 @@
+#pragma once
+// RegistrationViewLoader: the views of a view file as registration takes them: the view file (ViewFile), each view's
+// X-ray (XrayLoader), checked against its camera's detector, and the view's calibration-sphere shadows. The one
+// loader of the CLI (`register --views`) and the Studio (Data step).
+
+#include <filesystem>
+#include <vector>
+
+#include "Base/Result.h"
+#include "Registration/RegistrationView.h"
+
+namespace fct {
+
+/// Loads registration views.
+class RegistrationViewLoader {
+ public:
+  /// Reads the view file and every view's image, in the file's order. Fails naming the file and the view on a view
+  /// file error, a view without an image, an image that cannot be read, or an image whose size is not the detector's.
+  /// Warnings of the view file and of the images (the latter prefixed "view '<name>': ") are on the Result.
+  static Result<std::vector<RegistrationView>> load(const std::filesystem::path& viewFile);
+};
+
+}  // namespace fct
