@@ -243,10 +243,11 @@ void benchmarkCt(const std::string& name, const fct::Volume& ctIn, const Options
              level2.intrinsics().cols * level2.intrinsics().rows,
              100.0 * roi.size() / (level2.intrinsics().cols * level2.intrinsics().rows));
 
-  std::unique_ptr<fct::DrrRenderer> siddon =
-      std::move(fct::DrrRendererFactory::create(volume, {fct::DrrMethod::Siddon}).value());
-  std::unique_ptr<fct::DrrRenderer> raycast =
-      std::move(fct::DrrRendererFactory::create(volume, {fct::DrrMethod::RayCast}).value());
+  fct::DrrRendererOptions siddonOptions, raycastOptions;
+  siddonOptions.method = fct::DrrMethod::Siddon;
+  raycastOptions.method = fct::DrrMethod::RayCast;
+  std::unique_ptr<fct::DrrRenderer> siddon = std::move(fct::DrrRendererFactory::create(volume, siddonOptions).value());
+  std::unique_ptr<fct::DrrRenderer> raycast = std::move(fct::DrrRendererFactory::create(volume, raycastOptions).value());
   fct::FloatImage siddonImage;
   {
     tbb::global_control control(tbb::global_control::max_allowed_parallelism, options.threads);
