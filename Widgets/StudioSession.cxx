@@ -2,7 +2,10 @@
 
 #include <fmt/core.h>
 
+#include <array>
 #include <nlohmann/json.hpp>
+#include <string_view>
+#include <utility>
 
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
@@ -121,32 +124,15 @@ struct SessionContent {
   bool isAutosave = false;
 };
 
-/// The result object (RegistrationResultJson) and the verdict beside it.
-Result<RegistrationResult> readResult(const nlohmann::json& json, const std::string& where, ResultVerdict& verdict) {
-  JsonReader reader(json, where);
-  const std::string verdictText = reader.string("verdict");
-  if (reader.ok()) {
-    if (verdictText == "accepted") {
-      verdict = ResultVerdict::Accepted;
-    } else if (verdictText == "rejected") {
-      verdict = ResultVerdict::Rejected;
-    } else if (verdictText == "undecided") {
-      verdict = ResultVerdict::Undecided;
-    } else {
-      reader.rejectKey("verdict", fmt::format("is '{}'; use accepted, rejected or undecided", verdictText));
-    }
-  }
-  if (!reader.ok()) return fail(reader.error());
-  return RegistrationResultJson::read(json, where);
-}
+/// The session file being read: its name for messages, and the folder its relative paths start from.
+struct SessionFile {
+  std::string where;
+  fs::path folder;
+};
 
-Result<SessionContent> readSession(const fs::path& path) {
-  auto parsed = JsonDocument::parse(path);
-  if (!parsed) return fail(parsed.error());
-  const nlohmann::json& json = parsed.value();
-  const std::string where = path.string();
-  const fs::path folder = path.parent_path();
-  JsonReader reader(json, where);
+/// Checks "format" and "version" (1 up to the version this program writes). Fails naming the file and key for another
+/// format or a newer version.
+Status checkHeader(JsonReader& reader) {
   const std::string format = reader.string("format");
   if (reader.ok() && format != kFormat) {
     reader.rejectKey("format", fmt::format("is '{}', not '{}': this is not a FluoroCT Studio session file", format,
@@ -157,116 +143,213 @@ Result<SessionContent> readSession(const fs::path& path) {
     reader.rejectKey("version", fmt::format("is {}; this program reads version {} (update FluoroCT)", version, kVersion));
   }
   if (!reader.ok()) return fail(reader.error());
+  return Ok{};
+}
+
+/// Marks an autosave file (it has "autosave_of") and records the session file it belongs to (a non-string: none).
+void readAutosaveOwner(const JsonReader& reader, SessionContent& content) {
+  if (!reader.has("autosave_of")) return;
+  content.isAutosave = true;
+  if (const nlohmann::json* owner = reader.find("autosave_of"); owner->is_string()) {
+    content.autosaveOf = owner->get<std::string>();
+  }
+}
+
+/// "ct": loads the CT at its path (and series). Fails naming the key, or telling how to bring the CT back.
+Status readCtSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader ct(section, file.where + ": ct");
+  const std::string ctPath = ct.string("path");
+  DicomSeriesReadOptions options;
+  if (ct.has("series_uid")) options.seriesInstanceUid = ct.string("series_uid");
+  if (!ct.ok()) return fail(ct.error());
+  auto loaded = StudioDocument::readCt(resolvedPath(ctPath, file.folder), options);
+  if (!loaded) {
+    return fail(fmt::format("{}: the session's CT cannot be loaded ({}); put the CT back or edit ct.path in the "
+                            "session file",
+                            file.where, loaded.error()));
+  }
+  content.ct = std::move(loaded).value();
+  return Ok{};
+}
+
+/// "views.xray_files": loads each listed X-ray under its stored name. Fails naming the entry or the view.
+Result<LoadedViews> readXrayFiles(const nlohmann::json& files, const SessionFile& file) {
+  LoadedViews loaded;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    JsonReader entry(files[i], fmt::format("{}: views.xray_files[{}]", file.where, i));
+    const std::string name = entry.string("name");
+    const std::string xrayPath = entry.string("path");
+    if (!entry.ok()) return fail(entry.error());
+    auto view = StudioDocument::readXrayFile(resolvedPath(xrayPath, file.folder));
+    if (!view) return fail(fmt::format("{}: view '{}': {}", file.where, name, view.error()));
+    view.value().name = name;
+    loaded.views.push_back(std::move(view).value());
+  }
+  return loaded;
+}
+
+/// "views": loads the view file, or else the listed X-ray files. Fails naming the key or the file to bring back.
+Status readViewsSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader views(section, file.where + ": views");
+  if (views.has("view_file")) {
+    const std::string viewFile = views.string("view_file");
+    if (!views.ok()) return fail(views.error());
+    auto loaded = StudioDocument::readViews(resolvedPath(viewFile, file.folder));
+    if (!loaded) {
+      return fail(fmt::format("{}: the session's views cannot be loaded ({}); put the files back or edit "
+                              "views.view_file in the session file",
+                              file.where, loaded.error()));
+    }
+    content.views = std::move(loaded).value();
+    return Ok{};
+  }
+  if (const nlohmann::json* files = views.find("xray_files"); files && files->is_array()) {
+    auto loaded = readXrayFiles(*files, file);
+    if (!loaded) return fail(loaded.error());
+    content.views = std::move(loaded).value();
+    return Ok{};
+  }
+  return fail(file.where + ": views needs \"view_file\" or \"xray_files\"");
+}
+
+/// "landmarks.ct": the CT landmarks (p_ct_mm, LPS mm), appended to `landmarks`. Fails naming the entry.
+Status readCtLandmarks(const nlohmann::json& list, const SessionFile& file, Landmarks& landmarks) {
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    JsonReader l(list[i], fmt::format("{}: landmarks.ct[{}]", file.where, i));
+    CtLandmark landmark{l.string("name"), l.vector("p_ct_mm", 3)};
+    if (!l.ok()) return fail(l.error());
+    landmarks.ct.push_back(std::move(landmark));
+  }
+  return Ok{};
+}
+
+/// "landmarks.image": each view's image landmarks (uv_px), added to `landmarks`. Fails naming the view or entry.
+Status readImageLandmarks(const nlohmann::json& byView, const SessionFile& file, Landmarks& landmarks) {
+  for (const auto& [viewName, points] : byView.items()) {
+    if (!points.is_array()) return fail(fmt::format("{}: landmarks.image.{} must be an array", file.where, viewName));
+    std::vector<ImageLandmark>& list = landmarks.imageByView[viewName];
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      JsonReader l(points[i], fmt::format("{}: landmarks.image.{}[{}]", file.where, viewName, i));
+      ImageLandmark landmark{l.string("name"), l.vector("uv_px", 2)};
+      if (!l.ok()) return fail(l.error());
+      list.push_back(std::move(landmark));
+    }
+  }
+  return Ok{};
+}
+
+/// "landmarks": the CT and image landmarks (a missing or non-list part: none). Fails naming the bad entry.
+Status readLandmarksSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader landmarks(section, file.where + ": landmarks");
+  if (const nlohmann::json* ct = landmarks.find("ct"); ct && ct->is_array()) {
+    if (const Status read = readCtLandmarks(*ct, file, content.landmarks); !read) return read;
+  }
+  if (const nlohmann::json* image = landmarks.find("image"); image && image->is_object()) {
+    if (const Status read = readImageLandmarks(*image, file, content.landmarks); !read) return read;
+  }
+  return Ok{};
+}
+
+/// "initial_pose": T_world_from_ct (LPS mm) and where it came from (a non-string source: none). Fails naming the key.
+Status readInitialPoseSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader initial(section, file.where + ": initial_pose");
+  content.initialPose = PoseFile::readKey(initial, "T_world_from_ct");
+  if (initial.has("source")) {
+    if (const nlohmann::json* source = initial.find("source"); source->is_string()) {
+      content.initialPoseSource = QString::fromStdString(source->get<std::string>());
+    }
+  }
+  if (!initial.ok()) return fail(initial.error());
+  return Ok{};
+}
+
+/// "roi": the dynamic-ROI and exclusion parameters. Fails naming the key with a bad value.
+Status readRoiSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader roi(section, file.where + ": roi");
+  RoiParameters& r = content.roi;
+  r.windowSize = roi.integer("window_size", 2);
+  r.useThreshold = roi.boolean("use_threshold");
+  r.targetFraction = roi.positiveNumber("target_fraction");
+  r.varianceThreshold = roi.number("variance_threshold");
+  r.margin_px = roi.integer("margin_px", 0);
+  r.detectFieldOfView = roi.boolean("detect_field_of_view");
+  r.detectSpheres = roi.boolean("detect_spheres");
+  r.sphereMargin_px = roi.number("sphere_margin_px");
+  if (roi.ok() && r.targetFraction > 1.0) roi.rejectKey("target_fraction", "must be in (0, 1]");
+  if (!roi.ok()) return fail(roi.error());
+  return Ok{};
+}
+
+/// "registration": the preset, seed and DRR method. Fails naming the key with a bad value.
+Status readRegistrationSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader registration(section, file.where + ": registration");
+  content.options.preset = registration.string("preset");
+  content.options.seed = static_cast<std::uint32_t>(registration.integer("seed", 0));
+  content.options.drrMethod = registration.string("drr_method");
+  if (!registration.ok()) return fail(registration.error());
+  return Ok{};
+}
+
+/// "result": the last result (the RegistrationResultJson object, version 1 or 2) and the user's verdict beside it.
+/// Fails naming the key with a bad value.
+Status readResultSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  const std::string where = file.where + ": result";
+  JsonReader reader(section, where);
+  const std::string verdictText = reader.string("verdict");
+  if (reader.ok()) {
+    if (verdictText == "accepted") {
+      content.verdict = ResultVerdict::Accepted;
+    } else if (verdictText == "rejected") {
+      content.verdict = ResultVerdict::Rejected;
+    } else if (verdictText == "undecided") {
+      content.verdict = ResultVerdict::Undecided;
+    } else {
+      reader.rejectKey("verdict", fmt::format("is '{}'; use accepted, rejected or undecided", verdictText));
+    }
+  }
+  if (!reader.ok()) return fail(reader.error());
+  auto result = RegistrationResultJson::read(section, where);
+  if (!result) return fail(result.error());
+  content.result = std::move(result).value();
+  return Ok{};
+}
+
+/// "truth_pose": the known true T_world_from_ct (LPS mm) of a simulated case. Fails naming the key.
+Status readTruthPoseSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader truth(section, file.where + ": truth_pose");
+  content.truthPose = PoseFile::readKey(truth, "T_world_from_ct");
+  if (!truth.ok()) return fail(truth.error());
+  return Ok{};
+}
+
+/// Reads one optional section of a session file into the content.
+using SectionReader = Status (*)(const nlohmann::json& section, const SessionFile& file, SessionContent& content);
+
+/// The optional sections in the order they are read: the first one that fails ends the read.
+constexpr std::array<std::pair<std::string_view, SectionReader>, 8> kSections{{
+    {"ct", readCtSection},
+    {"views", readViewsSection},
+    {"landmarks", readLandmarksSection},
+    {"initial_pose", readInitialPoseSection},
+    {"roi", readRoiSection},
+    {"registration", readRegistrationSection},
+    {"result", readResultSection},
+    {"truth_pose", readTruthPoseSection},
+}};
+
+/// Reads a session (or autosave) file with its CT and X-rays loaded. Fails naming the file and key.
+Result<SessionContent> readSession(const fs::path& path) {
+  auto parsed = JsonDocument::parse(path);
+  if (!parsed) return fail(parsed.error());
+  const SessionFile file{path.string(), path.parent_path()};
+  JsonReader reader(parsed.value(), file.where);
+  if (const Status header = checkHeader(reader); !header) return fail(header.error());
 
   SessionContent content;
-  if (reader.has("autosave_of")) {
-    content.isAutosave = true;
-    if (const nlohmann::json* owner = reader.find("autosave_of"); owner->is_string()) {
-      content.autosaveOf = owner->get<std::string>();
-    }
-  }
-  if (reader.has("ct")) {
-    JsonReader ct(*reader.find("ct"), where + ": ct");
-    const std::string ctPath = ct.string("path");
-    DicomSeriesReadOptions options;
-    if (ct.has("series_uid")) options.seriesInstanceUid = ct.string("series_uid");
-    if (!ct.ok()) return fail(ct.error());
-    auto loaded = StudioDocument::readCt(resolvedPath(ctPath, folder), options);
-    if (!loaded) return fail(fmt::format("{}: the session's CT cannot be loaded ({}); put the CT back or edit ct.path in the "
-                                          "session file",
-                                          where, loaded.error()));
-    content.ct = std::move(loaded).value();
-  }
-  if (reader.has("views")) {
-    JsonReader views(*reader.find("views"), where + ": views");
-    if (views.has("view_file")) {
-      const std::string viewFile = views.string("view_file");
-      if (!views.ok()) return fail(views.error());
-      auto loaded = StudioDocument::readViews(resolvedPath(viewFile, folder));
-      if (!loaded) return fail(fmt::format("{}: the session's views cannot be loaded ({}); put the files back or edit "
-                                            "views.view_file in the session file",
-                                            where, loaded.error()));
-      content.views = std::move(loaded).value();
-    } else if (const nlohmann::json* files = views.find("xray_files"); files && files->is_array()) {
-      LoadedViews loaded;
-      for (std::size_t i = 0; i < files->size(); ++i) {
-        JsonReader file((*files)[i], fmt::format("{}: views.xray_files[{}]", where, i));
-        const std::string name = file.string("name");
-        const std::string xrayPath = file.string("path");
-        if (!file.ok()) return fail(file.error());
-        auto view = StudioDocument::readXrayFile(resolvedPath(xrayPath, folder));
-        if (!view) return fail(fmt::format("{}: view '{}': {}", where, name, view.error()));
-        view.value().name = name;
-        loaded.views.push_back(std::move(view).value());
-      }
-      content.views = std::move(loaded);
-    } else {
-      return fail(where + ": views needs \"view_file\" or \"xray_files\"");
-    }
-  }
-  if (reader.has("landmarks")) {
-    JsonReader landmarks(*reader.find("landmarks"), where + ": landmarks");
-    if (const nlohmann::json* ct = landmarks.find("ct"); ct && ct->is_array()) {
-      for (std::size_t i = 0; i < ct->size(); ++i) {
-        JsonReader l((*ct)[i], fmt::format("{}: landmarks.ct[{}]", where, i));
-        CtLandmark landmark{l.string("name"), l.vector("p_ct_mm", 3)};
-        if (!l.ok()) return fail(l.error());
-        content.landmarks.ct.push_back(std::move(landmark));
-      }
-    }
-    if (const nlohmann::json* image = landmarks.find("image"); image && image->is_object()) {
-      for (const auto& [viewName, points] : image->items()) {
-        if (!points.is_array()) return fail(fmt::format("{}: landmarks.image.{} must be an array", where, viewName));
-        std::vector<ImageLandmark>& list = content.landmarks.imageByView[viewName];
-        for (std::size_t i = 0; i < points.size(); ++i) {
-          JsonReader l(points[i], fmt::format("{}: landmarks.image.{}[{}]", where, viewName, i));
-          ImageLandmark landmark{l.string("name"), l.vector("uv_px", 2)};
-          if (!l.ok()) return fail(l.error());
-          list.push_back(std::move(landmark));
-        }
-      }
-    }
-  }
-  if (reader.has("initial_pose")) {
-    JsonReader initial(*reader.find("initial_pose"), where + ": initial_pose");
-    content.initialPose = PoseFile::readKey(initial, "T_world_from_ct");
-    if (initial.has("source")) {
-      if (const nlohmann::json* source = initial.find("source"); source->is_string()) {
-        content.initialPoseSource = QString::fromStdString(source->get<std::string>());
-      }
-    }
-    if (!initial.ok()) return fail(initial.error());
-  }
-  if (reader.has("roi")) {
-    JsonReader roi(*reader.find("roi"), where + ": roi");
-    RoiParameters& r = content.roi;
-    r.windowSize = roi.integer("window_size", 2);
-    r.useThreshold = roi.boolean("use_threshold");
-    r.targetFraction = roi.positiveNumber("target_fraction");
-    r.varianceThreshold = roi.number("variance_threshold");
-    r.margin_px = roi.integer("margin_px", 0);
-    r.detectFieldOfView = roi.boolean("detect_field_of_view");
-    r.detectSpheres = roi.boolean("detect_spheres");
-    r.sphereMargin_px = roi.number("sphere_margin_px");
-    if (roi.ok() && r.targetFraction > 1.0) roi.rejectKey("target_fraction", "must be in (0, 1]");
-    if (!roi.ok()) return fail(roi.error());
-  }
-  if (reader.has("registration")) {
-    JsonReader registration(*reader.find("registration"), where + ": registration");
-    content.options.preset = registration.string("preset");
-    content.options.seed = static_cast<std::uint32_t>(registration.integer("seed", 0));
-    content.options.drrMethod = registration.string("drr_method");
-    if (!registration.ok()) return fail(registration.error());
-  }
-  if (reader.has("result")) {
-    auto result = readResult(*reader.find("result"), where + ": result", content.verdict);
-    if (!result) return fail(result.error());
-    content.result = std::move(result).value();
-  }
-  if (reader.has("truth_pose")) {
-    JsonReader truth(*reader.find("truth_pose"), where + ": truth_pose");
-    content.truthPose = PoseFile::readKey(truth, "T_world_from_ct");
-    if (!truth.ok()) return fail(truth.error());
+  readAutosaveOwner(reader, content);
+  for (const auto& [key, read] : kSections) {
+    if (!reader.has(key)) continue;
+    if (const Status section = read(*reader.find(key), file, content); !section) return fail(section.error());
   }
   return content;
 }

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "Geometry/RigidPose.h"
@@ -13,6 +15,7 @@
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
 #include "Search/NelderMeadOptimizer.h"
+
 
 namespace fct {
 
@@ -45,6 +48,160 @@ std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage) {
   return std::make_unique<NelderMeadOptimizer>(o);
 }
 
+/// The start pose as a pose vector (deg about the bone centre, mm). Fails on an empty schedule, a non-rigid
+/// `T_initial`, or DRR and X-ray not overlapping at it at the first stage's level.
+Result<PoseVector> checkedStartPose(const RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
+                                    const RegistrationSchedule& schedule) {
+  if (schedule.stages.empty()) return fail(fmt::format("registration schedule '{}' has no stage", schedule.name));
+  auto initialParams = RigidPose::fromTransform(T_initial, registrationCase.rotationCentre_ct_mm());
+  if (!initialParams) return fail("initial pose: " + initialParams.error());
+  if (auto overlap = registrationCase.checkOverlap(T_initial, schedule.stages.front().level); !overlap) {
+    return fail(overlap.error());
+  }
+  return initialParams.value().asVector();
+}
+
+/// What building the per-view Transgraph tables before the first stage came to.
+struct TableSetup {
+  double seconds = 0.0;    ///< time the tables took; 0 when none were built
+  bool cancelled = false;  ///< the cancel flag stopped the build
+};
+
+/// Builds the case's per-view Transgraph tables around `T_initial` when the run renders with them and the case has
+/// none yet. Fails with the table builder's message (a cancelled build is not a failure).
+Result<TableSetup> prepareTransgraphTables(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
+                                           bool useViewRenderers, const ProgressMonitor& monitor) {
+  TableSetup setup;
+  if (!useViewRenderers || registrationCase.viewRenderersReady()) return setup;
+  const auto setupStart = Clock::now();
+  const Status tables = registrationCase.prepareViewRenderers(T_initial, monitor);
+  if (!tables) {
+    if (!monitor.cancelled()) return fail(tables.error());
+    setup.cancelled = true;
+    return setup;
+  }
+  setup.seconds = secondsSince(setupStart);
+  return setup;
+}
+
+/// The result of a run cancelled while its tables were built: the start pose, no stage.
+RegistrationResult cancelledBeforeFirstStage(RegistrationResult result, const Eigen::Isometry3d& T_initial,
+                                             Clock::time_point runStart) {
+  result.cancelled = true;
+  result.T_initial = result.T_world_from_ct = T_initial;
+  result.totalSeconds = secondsSince(runStart);
+  return result;
+}
+
+/// Every stage's objective (pixel sets and metric), built before the first search so that a stage that cannot run
+/// fails the registration at once instead of after the earlier stages' work. Fails with the failing stage's message.
+Result<std::vector<RegistrationObjective>> createObjectives(RegistrationCase& registrationCase,
+                                                            const RegistrationSchedule& schedule,
+                                                            const RegistrationAblation& ablation,
+                                                            bool useViewRenderers, const Eigen::Isometry3d& T_initial) {
+  std::vector<RegistrationObjective> objectives;
+  for (const RegistrationStage& stage : schedule.stages) {
+    auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
+                                                 ablation.noCtPyramid ? std::nullopt : std::optional(T_initial));
+    if (!created) return fail(created.error());
+    objectives.push_back(std::move(created).value());
+  }
+  return objectives;
+}
+
+/// What every stage of one run shares.
+struct StageContext {
+  RegistrationCase& registrationCase;
+  const ProgressMonitor& monitor;
+  const RegistrationProgressCallback& onProgress;
+  int stageCount = 0;
+};
+
+/// A stage's report before its search: the stage's settings, its start similarity and kept pixel fractions.
+StageReport startReport(const RegistrationStage& stage, double startSimilarity, const RegistrationObjective& objective) {
+  StageReport report;
+  report.name = stage.name;
+  report.metric = stage.metric;
+  report.level = stage.level;
+  report.search = stage.search;
+  report.startSimilarity = startSimilarity;
+  report.keptFraction = objective.keptFractions();
+  return report;
+}
+
+/// The progress report of stage `stageIndex` before its first evaluation.
+RegistrationProgress startProgress(const RegistrationStage& stage, int stageIndex, int stageCount,
+                                   double startSimilarity) {
+  RegistrationProgress progress;
+  progress.stageIndex = stageIndex;
+  progress.stageCount = stageCount;
+  progress.stage = stage.name;
+  progress.maxIterations = stage.maxEvaluations;
+  progress.bestSimilarity = startSimilarity;
+  return progress;
+}
+
+/// Takes the search's outcome into `report` and moves `current` to the found pose when it beats the stage's start
+/// (otherwise the start pose is kept). Fails with the search's message unless the run was cancelled.
+Status applySearchOutcome(const Result<OptimizationResult>& found, const ProgressMonitor& monitor, StageReport& report,
+                          PoseVector& current) {
+  report.similarity = report.startSimilarity;
+  if (found) {
+    report.evaluations = found.value().evaluations;
+    report.cancelled = found.value().cancelled;
+    if (-found.value().value > report.startSimilarity) {
+      current = found.value().params;
+      report.similarity = -found.value().value;
+    }
+  } else if (monitor.cancelled()) {
+    report.cancelled = true;  // cancelled before anything was evaluated: keep the stage's start pose
+  } else {
+    return fail(found.error());
+  }
+  return Ok{};
+}
+
+/// Runs stage `stageIndex` from `current` (pose parameters, deg and mm), moving `current` to the stage's best pose;
+/// `drrsBefore` counts the earlier stages' DRRs for the progress reports. Returns the stage's report; fails, naming
+/// the stage, on a rendering or search error.
+Result<StageReport> runStage(const StageContext& context, int stageIndex, const RegistrationStage& stage,
+                             RegistrationObjective& objective, long drrsBefore, PoseVector& current) {
+  const auto stageStart = Clock::now();
+  RegistrationCase& registrationCase = context.registrationCase;
+  auto startValue = objective.similarity(registrationCase.poseTransform(current));
+  if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
+  StageReport report = startReport(stage, startValue.value(), objective);
+
+  RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startValue.value());
+  std::string renderError;
+  const PoseObjective f = [&](const PoseVector& params) {
+    auto value = objective.similarity(registrationCase.poseTransform(params));
+    if (!value) {
+      if (renderError.empty()) renderError = value.error();
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    ++progress.iteration;
+    progress.drrs = drrsBefore + objective.drrCount();
+    progress.bestSimilarity = std::max(progress.bestSimilarity, value.value());
+    progress.fraction =
+        (stageIndex + std::min(1.0, static_cast<double>(progress.iteration) / progress.maxIterations)) /
+        context.stageCount;
+    if (context.onProgress) context.onProgress(progress);
+    return -value.value();
+  };
+
+  const std::unique_ptr<PoseOptimizer> optimizer = makeOptimizer(stage);
+  auto found = optimizer->minimize(f, current, registrationCase.scales(), context.monitor);
+  if (!renderError.empty()) return fail(fmt::format("stage '{}': {}", stage.name, renderError));
+  if (const Status applied = applySearchOutcome(found, context.monitor, report, current); !applied) {
+    return fail(fmt::format("stage '{}': {}", stage.name, applied.error()));
+  }
+  report.drrs = objective.drrCount();
+  report.fallbackRays = objective.fallbackRayCount();
+  report.seconds = secondsSince(stageStart);
+  return report;
+}
+
 }  // namespace
 
 Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
@@ -55,108 +212,35 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
   RegistrationResult result;
   result.schedule = options.schedule.withAblation(options.ablation).withSeed(options.seed);
   const RegistrationSchedule& schedule = result.schedule;
-  if (schedule.stages.empty()) return fail(fmt::format("registration schedule '{}' has no stage", schedule.name));
-  auto initialParams = RigidPose::fromTransform(T_initial, registrationCase.rotationCentre_ct_mm());
-  if (!initialParams) return fail("initial pose: " + initialParams.error());
-  if (auto overlap = registrationCase.checkOverlap(T_initial, schedule.stages.front().level); !overlap) {
-    return fail(overlap.error());
-  }
+  auto start = checkedStartPose(registrationCase, T_initial, schedule);
+  if (!start) return fail(start.error());
+
   const ProgressMonitor monitor(ProgressMonitor::Callback{}, cancel);
   const bool useViewRenderers = !options.ablation.noTransgraph;
-  if (useViewRenderers && !registrationCase.viewRenderersReady()) {
-    const auto setupStart = Clock::now();
-    const Status tables = registrationCase.prepareViewRenderers(T_initial, monitor);
-    if (!tables) {
-      if (monitor.cancelled()) {
-        result.cancelled = true;
-        result.T_initial = result.T_world_from_ct = T_initial;
-        result.totalSeconds = secondsSince(runStart);
-        return result;
-      }
-      return fail(tables.error());
-    }
-    result.viewRendererSetupSeconds = secondsSince(setupStart);
-  }
+  auto tables = prepareTransgraphTables(registrationCase, T_initial, useViewRenderers, monitor);
+  if (!tables) return fail(tables.error());
+  if (tables.value().cancelled) return cancelledBeforeFirstStage(std::move(result), T_initial, runStart);
+  result.viewRendererSetupSeconds = tables.value().seconds;
   result.T_initial = T_initial;
   result.rotationCentre_ct_mm = registrationCase.rotationCentre_ct_mm();
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) result.viewNames.push_back(registrationCase.viewName(v));
 
-  // Every stage's pixel sets and metrics are built before the first search, so a stage that cannot run fails the
-  // registration at once instead of after the earlier stages' work.
-  std::vector<RegistrationObjective> objectives;
-  for (const RegistrationStage& stage : schedule.stages) {
-    auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
-                                                 options.ablation.noCtPyramid ? std::nullopt
-                                                                              : std::optional(T_initial));
-    if (!created) return fail(created.error());
-    objectives.push_back(std::move(created).value());
-  }
-  result.drrMethod = std::string(objectives.front().drrMethodName());
-  PoseVector current = initialParams.value().asVector();
-  const int stageCount = static_cast<int>(schedule.stages.size());
+  auto objectives = createObjectives(registrationCase, schedule, options.ablation, useViewRenderers, T_initial);
+  if (!objectives) return fail(objectives.error());
+  result.drrMethod = std::string(objectives.value().front().drrMethodName());
 
-  for (int s = 0; s < stageCount; ++s) {
-    const RegistrationStage& stage = schedule.stages[static_cast<std::size_t>(s)];
+  const StageContext context{registrationCase, monitor, onProgress, static_cast<int>(schedule.stages.size())};
+  PoseVector current = start.value();
+  for (int s = 0; s < context.stageCount; ++s) {
     if (monitor.cancelled()) {
       result.cancelled = true;
       break;
     }
-    const auto stageStart = Clock::now();
-    RegistrationObjective& objective = objectives[static_cast<std::size_t>(s)];
-    auto startValue = objective.similarity(registrationCase.poseTransform(current));
-    if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
-
-    StageReport report;
-    report.name = stage.name;
-    report.metric = stage.metric;
-    report.level = stage.level;
-    report.search = stage.search;
-    report.startSimilarity = startValue.value();
-    report.keptFraction = objective.keptFractions();
-
-    RegistrationProgress progress;
-    progress.stageIndex = s;
-    progress.stageCount = stageCount;
-    progress.stage = stage.name;
-    progress.maxIterations = stage.maxEvaluations;
-    progress.bestSimilarity = startValue.value();
-    std::string renderError;
-    const PoseObjective f = [&](const PoseVector& params) {
-      auto value = objective.similarity(registrationCase.poseTransform(params));
-      if (!value) {
-        if (renderError.empty()) renderError = value.error();
-        return std::numeric_limits<double>::quiet_NaN();
-      }
-      ++progress.iteration;
-      progress.drrs = result.totalDrrs + objective.drrCount();
-      progress.bestSimilarity = std::max(progress.bestSimilarity, value.value());
-      progress.fraction = (s + std::min(1.0, static_cast<double>(progress.iteration) / progress.maxIterations)) /
-                          stageCount;
-      if (onProgress) onProgress(progress);
-      return -value.value();
-    };
-
-    const std::unique_ptr<PoseOptimizer> optimizer = makeOptimizer(stage);
-    auto found = optimizer->minimize(f, current, registrationCase.scales(), monitor);
-    if (!renderError.empty()) return fail(fmt::format("stage '{}': {}", stage.name, renderError));
-    report.similarity = report.startSimilarity;
-    if (found) {
-      report.evaluations = found.value().evaluations;
-      report.cancelled = found.value().cancelled;
-      if (-found.value().value > report.startSimilarity) {
-        current = found.value().params;
-        report.similarity = -found.value().value;
-      }
-    } else if (monitor.cancelled()) {
-      report.cancelled = true;  // cancelled before anything was evaluated: keep the stage's start pose
-    } else {
-      return fail(fmt::format("stage '{}': {}", stage.name, found.error()));
-    }
-    report.drrs = objective.drrCount();
-    report.fallbackRays = objective.fallbackRayCount();
-    report.seconds = secondsSince(stageStart);
-    result.totalDrrs += report.drrs;
-    result.stages.push_back(std::move(report));
+    const auto i = static_cast<std::size_t>(s);
+    auto report = runStage(context, s, schedule.stages[i], objectives.value()[i], result.totalDrrs, current);
+    if (!report) return fail(report.error());
+    result.totalDrrs += report.value().drrs;
+    result.stages.push_back(std::move(report).value());
     if (result.stages.back().cancelled) {
       result.cancelled = true;
       break;

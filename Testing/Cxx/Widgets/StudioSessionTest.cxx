@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "Base/JsonDocument.h"
 #include "Registration/RegistrationResultJson.h"
@@ -147,6 +150,35 @@ TEST(StudioSession, BadSessionFileLeavesTheDocumentAsItWas) {
   EXPECT_EQ(document.landmarks().ct.size(), 2u);
   EXPECT_TRUE(document.result());
   EXPECT_TRUE(document.isModified());
+}
+
+TEST(StudioSession, BadValueMessagesNameTheSectionAndEntry) {
+  // Each file is valid JSON of the session format with one bad section; the message names where to fix it.
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {R"("version": 3)", "version"},
+      {R"("views": {"files": []})", "views needs \"view_file\" or \"xray_files\""},
+      {R"("views": {"xray_files": [{"name": "ap"}]})", "views.xray_files[0]"},
+      {R"("landmarks": {"ct": [{"name": "L1", "p_ct_mm": [1, 2, 3]}, {"name": "L2"}]})", "landmarks.ct[1]"},
+      {R"("landmarks": {"image": {"ap": {"name": "L1"}}})", "landmarks.image.ap must be an array"},
+      {R"("landmarks": {"image": {"ap": [{"name": "L1", "uv_px": [1]}]}})", "landmarks.image.ap[0]"},
+      {R"("initial_pose": {"source": "landmarks"})", "initial_pose"},
+      {R"("roi": {"window_size": 7, "use_threshold": false, "target_fraction": 1.5, "variance_threshold": 0,
+                  "margin_px": 0, "detect_field_of_view": true, "detect_spheres": true, "sphere_margin_px": 2})",
+       "target_fraction"},
+      {R"("registration": {"preset": "fast", "seed": -1, "drr_method": "siddon"})", "registration"},
+      {R"("result": {"verdict": "maybe"})", "use accepted, rejected or undecided"},
+      {R"("truth_pose": {"T_world_from_ct": [[1, 0], [0, 1]]})", "truth_pose"},
+  };
+  const auto path = fct::test::scratchDir() / "bad.fctsession.json";
+  for (const auto& [section, expected] : cases) {
+    std::ofstream(path) << R"({"format": "fluoroct-studio-session", "version": 2, )" << section << "}";
+    StudioDocument document;
+    const fct::Status opened = StudioSession::open(document, path);
+    ASSERT_FALSE(opened.ok()) << section;
+    EXPECT_NE(opened.error().find(path.string()), std::string::npos) << opened.error();
+    EXPECT_NE(opened.error().find(expected), std::string::npos) << opened.error();
+    EXPECT_FALSE(document.isModified()) << section;
+  }
 }
 
 TEST(StudioSession, AutosaveReopensModifiedAndRemembersItsSessionFile) {

@@ -2,6 +2,7 @@
 // level, exact fallback outside the tables, the noTransgraph ablation, and tables built lazily at the initial pose.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -160,6 +161,25 @@ TEST(RegistrationTransgraph, NoTransgraphAblationRendersExactly) {
   EXPECT_EQ(result.value().drrMethod, "transgraph");
   EXPECT_GT(result.value().viewRendererSetupSeconds, 0.0);
   EXPECT_GT(c.viewRendererSetupSeconds(), 0.0);
+}
+
+TEST(RegistrationTransgraph, CancelWhileTheTablesAreBuiltKeepsTheInitialPoseAndNoTable) {
+  const fct::test::KnownTruthCase sim = coarseCase();
+  auto created = fct::RegistrationCase::create(sim.ct, sim.views, transgraphOptions());
+  ASSERT_TRUE(created.ok()) << created.error();
+  fct::RegistrationCase& c = created.value();
+  ASSERT_FALSE(c.viewRenderersReady());
+  const Eigen::Isometry3d start = fct::test::startPose(c, sim.T_truth, 3.0, 5);
+  std::atomic<bool> cancel{true};
+  auto result = fct::Registration::run(c, start, fastOptions(), {}, &cancel);
+  ASSERT_TRUE(result.ok()) << result.error();
+  const fct::RegistrationResult& r = result.value();
+  EXPECT_TRUE(r.cancelled);
+  EXPECT_TRUE(r.stages.empty());
+  EXPECT_TRUE(r.T_world_from_ct.isApprox(start));
+  EXPECT_TRUE(r.T_initial.isApprox(start));
+  EXPECT_EQ(r.viewRendererSetupSeconds, 0.0);
+  EXPECT_FALSE(c.viewRenderersReady()) << "a cancelled build leaves no half-built table";
 }
 
 TEST(RegistrationTransgraph, FailsClearlyWhenATableCannotBePlanned) {
