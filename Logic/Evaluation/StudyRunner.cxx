@@ -295,7 +295,9 @@ void recordTrial(TrialWork& work, const TrialRecord& record) {
   ++work.summary.ran;
   if (record.status == TrialStatus::Failed) ++work.summary.failed;
   if (record.status == TrialStatus::Cancelled) work.summary.cancelled = true;
-  if (Status saved = work.store.add(record); !saved && !work.storeFailed.exchange(true)) work.storeError = saved.error();
+  if (Status saved = work.store.add(record); !saved && !work.storeFailed.exchange(true)) {
+    work.storeError = saved.error();
+  }
   ++work.finished;
   if (work.options.onTrial) {
     work.options.onTrial(StudyProgress{work.finished, static_cast<int>(work.pending.size()), record});

@@ -153,7 +153,8 @@ double noiselessSignal(const Scene& scene, const SpectrumWeights& w, const MassP
 }
 
 /// The intensifier distortion the options ask for; none when pincushion and S-distortion are 0.
-Result<std::optional<IntensifierDistortion>> distortionFor(const CameraIntrinsics& in, const FluoroscopyOptions& options) {
+Result<std::optional<IntensifierDistortion>> distortionFor(const CameraIntrinsics& in,
+                                                           const FluoroscopyOptions& options) {
   if (options.pincushion == 0.0 && options.sDistortion_deg == 0.0) return std::optional<IntensifierDistortion>();
   auto created = IntensifierDistortion::create(in.cols, in.rows, options.pincushion, options.sDistortion_deg);
   if (!created.ok()) return fail(created.error());
@@ -201,7 +202,8 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
 
 /// Sets the view's maxLineIntegral and referenceSignal (automatic exposure: the 99th percentile of the exposed
 /// noiseless signals; else 1) from its noiseless image. Fails when no pixel is exposed or no X-ray gets through.
-Status measureExposure(const std::vector<std::uint8_t>& exposed, const FluoroscopyOptions& options, RenderedView& view) {
+Status measureExposure(const std::vector<std::uint8_t>& exposed, const FluoroscopyOptions& options,
+                       RenderedView& view) {
   std::vector<float> field;
   for (std::size_t index = 0; index < exposed.size(); ++index) {
     if (exposed[index]) field.push_back(view.image.pixels[index]);

@@ -96,7 +96,7 @@ Eigen::Vector3d jitter(const Eigen::Vector3d& direction, double maxAngle_rad, Se
 /// Where implants go on a CT's bone: the bone centroid and the surface voxels nearest to it.
 struct ImplantSites {
   Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();  ///< LPS
-  std::vector<Eigen::Vector3i> surface;                    ///< voxel indices: the half of the surface nearest the centroid
+  std::vector<Eigen::Vector3i> surface;  ///< voxel indices: the half of the surface nearest the centroid
 };
 
 /// The bone centroid and surface voxels (bone with a non-bone 6-neighbour; the grid border counts as non-bone) of
@@ -105,7 +105,8 @@ struct ImplantSites {
 Result<ImplantSites> findImplantSites(const Volume& ct, double boneThreshold_hu) {
   const Eigen::Vector3i& dims = ct.dims();
   const auto isBone = [&](int i, int j, int k) {
-    return i >= 0 && j >= 0 && k >= 0 && i < dims.x() && j < dims.y() && k < dims.z() && ct.at(i, j, k) >= boneThreshold_hu;
+    return i >= 0 && j >= 0 && k >= 0 && i < dims.x() && j < dims.y() && k < dims.z() &&
+           ct.at(i, j, k) >= boneThreshold_hu;
   };
   Eigen::Vector3d sum_ijk = Eigen::Vector3d::Zero();
   double boneCount = 0.0;
@@ -215,7 +216,8 @@ bool isSoftTissue(const Volume& ct, const Eigen::Vector3d& p_mm) {
 
 /// A gas pocket: of up to 500 random spheres (r 8..20 mm, centre within 100 mm of centroid_mm), the first whose centre
 /// and 26 surface points all lie in soft tissue; none when no attempt fits.
-std::optional<ForeignObject> placeGasPocket(const Volume& ct, const Eigen::Vector3d& centroid_mm, SeededRandom& random) {
+std::optional<ForeignObject> placeGasPocket(const Volume& ct, const Eigen::Vector3d& centroid_mm,
+                                            SeededRandom& random) {
   for (int attempt = 0; attempt < 500; ++attempt) {
     const Eigen::Vector3d centre = centroid_mm + randomUnit(random) * random.uniform(0.0, 100.0);
     const double radius = random.uniform(8.0, 20.0);
@@ -223,7 +225,9 @@ std::optional<ForeignObject> placeGasPocket(const Volume& ct, const Eigen::Vecto
     for (int a = -1; a <= 1 && placed; ++a) {
       for (int b = -1; b <= 1 && placed; ++b) {
         for (int c = -1; c <= 1 && placed; ++c) {
-          if (a != 0 || b != 0 || c != 0) placed = isSoftTissue(ct, centre + radius * Eigen::Vector3d(a, b, c).normalized());
+          if (a != 0 || b != 0 || c != 0) {
+            placed = isSoftTissue(ct, centre + radius * Eigen::Vector3d(a, b, c).normalized());
+          }
         }
       }
     }
