@@ -6,9 +6,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -73,9 +71,6 @@ Result<StudyDefinition> defineStudy(const EvaluateOptions& o, const std::vector<
   if (method.value() == DrrMethod::Transgraph) setup.transgraphCacheDir = transgraphCacheDir(o.out);
   return study;
 }
-
-std::atomic<bool> g_cancel{false};
-extern "C" void onEvaluateInterrupt(int) { g_cancel.store(true); }
 
 /// The shared data folder named by $FLUOROCT_DATA_DIR; empty when it is not set.
 fs::path dataDir() {
@@ -205,7 +200,7 @@ int runEvaluate(const EvaluateOptions& o) {
 
   StudyRunOptions run;
   run.jobs = o.jobs;
-  run.cancel = &g_cancel;
+  run.cancel = InterruptGuard::cancelFlag();
   run.onMessage = [](const std::string& text) { fmt::print(stderr, "evaluate: {}\n", text); };
   run.onTrial = [](const StudyProgress& p) {
     const TrialRecord& r = p.record;
@@ -215,10 +210,10 @@ int runEvaluate(const EvaluateOptions& o) {
                r.reason.empty() ? "" : " (" + r.reason + ")", r.seconds,
                r.setupSeconds > 0 ? fmt::format(" (+{:.1f} s tables)", r.setupSeconds) : "", r.drrs);
   };
-  g_cancel = false;
-  const auto previousHandler = std::signal(SIGINT, onEvaluateInterrupt);
-  auto summary = StudyRunner::run(study.value(), cts.value(), store.value(), run);
-  std::signal(SIGINT, previousHandler);
+  auto summary = [&] {
+    const InterruptGuard interrupt;  // Ctrl-C stops the trials (the finished ones stay saved) until the run returns
+    return StudyRunner::run(study.value(), cts.value(), store.value(), run);
+  }();
   if (!summary) return reportError(summary.error());
 
   std::vector<std::string> notes = StudyRunner::notes(study.value(), cts.value());

@@ -44,11 +44,35 @@ struct PendingTrial {
   int trial = 0;
 };
 
+/// The scenes of a run, by CT label.
+using CtScenes = std::map<std::string, CtScene>;
+
+/// The prepared registration cases of a run, by caseKey.
+using CasePrototypes = std::map<std::string, std::unique_ptr<RegistrationCase>>;
+
+/// What the workers of a run share: its prepared inputs (read only) and its progress (`next`; the rest under `mutex`).
+struct TrialWork {
+  const StudyDefinition& study;
+  const std::vector<PendingTrial>& pending;
+  const CtScenes& scenes;
+  const CasePrototypes& prototypes;
+  std::map<StudyMeasures, RegistrationSchedule> schedules;  ///< by the conditions' measures
+  const StudyRunOptions& options;
+  TrialStore& store;
+  StudyRunSummary& summary;
+  std::mutex mutex{};
+  std::atomic<std::size_t> next{0};     ///< the next pending trial to take
+  std::atomic<bool> storeFailed{false};
+  std::string storeError{};
+  int finished = 0;
+};
+
 /// Conditions registering on the same CT (after resampling, if any) with the same views share a case.
 std::string caseKey(const StudyCondition& c, const Volume& ct) {
   return fmt::format("{}|{}|{}", c.ct, StudyXraySource::effectiveSliceSpacing_mm(ct, c.sliceSpacing_mm), c.viewCount);
 }
 
+/// Checks the job count and every condition (unique name, known CT, views, trials, initial range) before any work.
 Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, const StudyRunOptions& options) {
   if (options.jobs < 1 || options.jobs > StudyRunner::kMaxJobs) {
     return fail(fmt::format("parallel jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, options.jobs));
@@ -128,6 +152,187 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
   return r;
 }
 
+/// Passes a preparation step to StudyRunOptions::onMessage, when one is set.
+void say(const StudyRunOptions& options, const std::string& text) {
+  if (options.onMessage) options.onMessage(text);
+}
+
+/// True once the run's cancel flag is set.
+bool cancelRequested(const StudyRunOptions& options) { return options.cancel && options.cancel->load(); }
+
+/// The trials of `study` that `store` does not hold yet, by condition then trial index; adds the others to `skipped`.
+std::vector<PendingTrial> findPendingTrials(const StudyDefinition& study, const TrialStore& store, int& skipped) {
+  std::vector<PendingTrial> pending;
+  for (const StudyCondition& c : study.conditions) {
+    for (int t = 0; t < c.trials; ++t) {
+      if (store.isDone(study.name, c.name, t)) {
+        ++skipped;
+      } else {
+        pending.push_back(PendingTrial{&c, t});
+      }
+    }
+  }
+  return pending;
+}
+
+/// The most views any pending trial on the CT labelled `label` needs; 0 when none uses it.
+int viewsNeeded(const std::vector<PendingTrial>& pending, const std::string& label) {
+  int viewCount = 0;
+  for (const PendingTrial& p : pending) {
+    if (p.condition->ct == label) viewCount = std::max(viewCount, p.condition->viewCount);
+  }
+  return viewCount;
+}
+
+/// The scene of one CT: its error measures, true pose and `viewCount` standard views simulated at that pose. Fails on
+/// a CT without bone, bad view settings or a simulation error.
+Result<CtScene> simulateScene(const StudyCt& ct, int viewCount, const StudySetup& setup,
+                              const StudyRunOptions& options) {
+  CtScene scene;
+  scene.ct = &ct.volume;
+  auto metrics = PoseErrorMetrics::create(ct.volume);
+  if (!metrics) return fail(fmt::format("CT '{}': {}", ct.label, metrics.error()));
+  scene.metrics = std::make_unique<PoseErrorMetrics>(std::move(metrics).value());
+  scene.T_truth = StudyRunner::truthPose(scene.metrics->surface());
+  StandardViewOptions viewOptions = setup.detector;
+  viewOptions.count = viewCount;
+  auto views = StandardViews::build(Eigen::Vector3d::Zero(), viewOptions);
+  if (!views) return fail(views.error());
+  say(options, fmt::format("simulating {} X-ray views of CT '{}'", viewCount, ct.label));
+  auto xrays = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, setup.seed);
+  if (!xrays) return fail(fmt::format("CT '{}': {}", ct.label, xrays.error()));
+  scene.xrays = std::move(xrays).value();
+  return scene;
+}
+
+/// The scenes of the CTs that pending trials use, by CT label, each with as many views as its trials need.
+Result<CtScenes> simulateScenes(const StudyDefinition& study, const std::vector<StudyCt>& cts,
+                                const std::vector<PendingTrial>& pending, const StudyRunOptions& options) {
+  CtScenes scenes;
+  for (const StudyCt& ct : cts) {
+    const int viewCount = viewsNeeded(pending, ct.label);
+    if (viewCount == 0) continue;
+    auto scene = simulateScene(ct, viewCount, study.setup, options);
+    if (!scene) return fail(scene.error());
+    scenes.emplace(ct.label, std::move(scene).value());
+  }
+  return scenes;
+}
+
+/// The case options of the study's DRR method: the method, its transgraph step and table cache folder (if any).
+RegistrationCaseOptions caseOptionsFor(const StudySetup& setup) {
+  RegistrationCaseOptions caseOptions;
+  caseOptions.drr.method = setup.method;
+  caseOptions.drr.transgraph.spacing_mm = setup.transgraphSpacing_mm;
+  caseOptions.drr.transgraphCacheFolder = setup.transgraphCacheDir.empty()
+                                              ? std::nullopt
+                                              : std::optional<std::filesystem::path>(setup.transgraphCacheDir);
+  return caseOptions;
+}
+
+/// One prepared registration case per caseKey of the pending trials (registration CT and the first views of its
+/// scene), copied by each worker (transgraph method: by each trial, whose tables are then built around its own start
+/// pose by Registration::run). Fails, naming the CT and scenario, when the CT cannot be resampled or the case prepared.
+Result<CasePrototypes> prepareCases(const StudyDefinition& study, const std::vector<PendingTrial>& pending,
+                                    const CtScenes& scenes, const StudyRunOptions& options) {
+  const RegistrationCaseOptions caseOptions = caseOptionsFor(study.setup);
+  CasePrototypes prototypes;
+  for (const PendingTrial& p : pending) {
+    const StudyCondition& c = *p.condition;
+    const CtScene& scene = scenes.at(c.ct);
+    const std::string key = caseKey(c, *scene.ct);
+    if (prototypes.count(key)) continue;
+    const double sliceSpacing_mm = StudyXraySource::effectiveSliceSpacing_mm(*scene.ct, c.sliceSpacing_mm);
+    say(options, fmt::format("preparing registration on CT '{}' ({}) with {} views", c.ct,
+                             sliceSpacing_mm > 0 ? fmt::format("{:g} mm slices", sliceSpacing_mm) : "original slices",
+                             c.viewCount));
+    auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
+    if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
+    const std::vector<RegistrationView> views(scene.xrays.begin(), scene.xrays.begin() + c.viewCount);
+    auto created = RegistrationCase::create(registrationCt.value(), views, caseOptions);
+    if (!created) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, created.error()));
+    prototypes.emplace(key, std::make_unique<RegistrationCase>(std::move(created).value()));
+  }
+  return prototypes;
+}
+
+/// The schedule of each StudyMeasures, derived from the preset's `base`.
+std::map<StudyMeasures, RegistrationSchedule> schedulesFor(const RegistrationSchedule& base) {
+  std::map<StudyMeasures, RegistrationSchedule> schedules;
+  for (StudyMeasures m : {StudyMeasures::Both, StudyMeasures::NccOnly, StudyMeasures::VlncOnly}) {
+    schedules.emplace(m, StudyRunner::scheduleFor(base, m));
+  }
+  return schedules;
+}
+
+/// A worker's case for a trial with this key: a copy of the prototype made on first use and kept for the worker's
+/// later trials, except with per-trial tables (transgraph), where every trial starts again from the prototype.
+RegistrationCase& caseForTrial(std::map<std::string, RegistrationCase>& ownCases, const std::string& key,
+                               const CasePrototypes& prototypes, bool tablePerTrial) {
+  auto found = ownCases.find(key);
+  if (found == ownCases.end()) {
+    found = ownCases.emplace(key, *prototypes.at(key)).first;
+  } else if (tablePerTrial) {
+    found->second = *prototypes.at(key);  // no tables yet: this trial builds (or loads) them around its start
+  }
+  return found->second;
+}
+
+/// Runs pending trial `i` on `registrationCase`; an exception (e.g. out of memory) makes it a Failed trial.
+TrialRecord runTrialSafely(const TrialWork& work, std::size_t i, RegistrationCase& registrationCase) {
+  const StudyCondition& c = *work.pending[i].condition;
+  try {
+    return runTrial(work.study, c, work.pending[i].trial, work.scenes.at(c.ct), registrationCase,
+                    work.schedules.at(c.measures), work.options.cancel);
+  } catch (const std::exception& e) {  // this trial fails, the study goes on
+    return failedTrial(work.study, c, work.pending[i].trial, fmt::format("unexpected error: {}", e.what()));
+  }
+}
+
+/// Counts a finished trial in the summary, adds it to the store (keeping the first store error) and reports it.
+void recordTrial(TrialWork& work, const TrialRecord& record) {
+  const std::lock_guard lock(work.mutex);
+  ++work.summary.ran;
+  if (record.status == TrialStatus::Failed) ++work.summary.failed;
+  if (record.status == TrialStatus::Cancelled) work.summary.cancelled = true;
+  if (Status saved = work.store.add(record); !saved && !work.storeFailed.exchange(true)) {
+    work.storeError = saved.error();
+  }
+  ++work.finished;
+  if (work.options.onTrial) {
+    work.options.onTrial(StudyProgress{work.finished, static_cast<int>(work.pending.size()), record});
+  }
+}
+
+/// One worker: takes the next pending trial until none is left, the store failed or the run is cancelled.
+void workOnTrials(TrialWork& work) {
+  const bool tablePerTrial = work.study.setup.method == DrrMethod::Transgraph;
+  std::map<std::string, RegistrationCase> ownCases;
+  for (;;) {
+    const std::size_t i = work.next.fetch_add(1);
+    if (i >= work.pending.size() || work.storeFailed.load() || cancelRequested(work.options)) return;
+    const StudyCondition& c = *work.pending[i].condition;
+    const std::string key = caseKey(c, *work.scenes.at(c.ct).ct);
+    RegistrationCase& registrationCase = caseForTrial(ownCases, key, work.prototypes, tablePerTrial);
+    recordTrial(work, runTrialSafely(work, i, registrationCase));
+  }
+}
+
+/// Runs the pending trials on min(jobs, trials) workers (the calling thread when one). Fails when the store could
+/// not be written.
+Status runTrials(TrialWork& work) {
+  const int threads = std::min<int>(work.options.jobs, static_cast<int>(work.pending.size()));
+  if (threads == 1) {
+    workOnTrials(work);
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back([&work] { workOnTrials(work); });
+    for (std::thread& thread : pool) thread.join();
+  }
+  if (work.storeFailed) return fail("cannot save the trials: " + work.storeError);
+  return Ok{};
+}
+
 }  // namespace
 
 Eigen::Isometry3d StudyRunner::truthPose(const BoneSurface& bone) {
@@ -189,126 +394,21 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
   if (Status valid = validate(study, cts, options); !valid) return fail(valid.error());
   auto baseSchedule = RegistrationSchedule::resolve(study.setup.preset);
   if (!baseSchedule) return fail(baseSchedule.error());
-  const auto message = [&](const std::string& text) {
-    if (options.onMessage) options.onMessage(text);
-  };
 
   StudyRunSummary summary;
-  std::vector<PendingTrial> pending;
-  for (const StudyCondition& c : study.conditions) {
-    for (int t = 0; t < c.trials; ++t) {
-      if (store.isDone(study.name, c.name, t)) {
-        ++summary.skipped;
-      } else {
-        pending.push_back(PendingTrial{&c, t});
-      }
-    }
+  const std::vector<PendingTrial> pending = findPendingTrials(study, store, summary.skipped);
+  if (summary.skipped > 0) {
+    say(options, fmt::format("{} trials already in {}; skipping them", summary.skipped, store.path().string()));
   }
-  if (summary.skipped > 0) message(fmt::format("{} trials already in {}; skipping them", summary.skipped, store.path().string()));
   if (pending.empty()) return summary;
-
-  // Per CT: measures, truth and X-rays for as many views as any pending trial needs.
-  std::map<std::string, CtScene> scenes;
-  for (const StudyCt& ct : cts) {
-    int viewCount = 0;
-    for (const PendingTrial& p : pending) {
-      if (p.condition->ct == ct.label) viewCount = std::max(viewCount, p.condition->viewCount);
-    }
-    if (viewCount == 0) continue;
-    CtScene scene;
-    scene.ct = &ct.volume;
-    auto metrics = PoseErrorMetrics::create(ct.volume);
-    if (!metrics) return fail(fmt::format("CT '{}': {}", ct.label, metrics.error()));
-    scene.metrics = std::make_unique<PoseErrorMetrics>(std::move(metrics).value());
-    scene.T_truth = truthPose(scene.metrics->surface());
-    StandardViewOptions viewOptions = study.setup.detector;
-    viewOptions.count = viewCount;
-    auto views = StandardViews::build(Eigen::Vector3d::Zero(), viewOptions);
-    if (!views) return fail(views.error());
-    message(fmt::format("simulating {} X-ray views of CT '{}'", viewCount, ct.label));
-    auto xrays = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, study.setup.seed);
-    if (!xrays) return fail(fmt::format("CT '{}': {}", ct.label, xrays.error()));
-    scene.xrays = std::move(xrays).value();
-    scenes.emplace(ct.label, std::move(scene));
-  }
-
-  // Per (CT, slice spacing, view count): one prepared registration case, copied by each worker (transgraph method: by
-  // each trial, whose tables are then built around its own start pose by Registration::run).
-  RegistrationCaseOptions caseOptions;
-  caseOptions.drr.method = study.setup.method;
-  caseOptions.drr.transgraph.spacing_mm = study.setup.transgraphSpacing_mm;
-  caseOptions.drr.transgraphCacheFolder = study.setup.transgraphCacheDir.empty()
-                                              ? std::nullopt
-                                              : std::optional<std::filesystem::path>(study.setup.transgraphCacheDir);
-  const bool tablePerTrial = study.setup.method == DrrMethod::Transgraph;
-  std::map<std::string, std::unique_ptr<RegistrationCase>> prototypes;
-  for (const PendingTrial& p : pending) {
-    const StudyCondition& c = *p.condition;
-    const CtScene& scene = scenes.at(c.ct);
-    const std::string key = caseKey(c, *scene.ct);
-    if (prototypes.count(key)) continue;
-    const double sliceSpacing_mm = StudyXraySource::effectiveSliceSpacing_mm(*scene.ct, c.sliceSpacing_mm);
-    message(fmt::format("preparing registration on CT '{}' ({}) with {} views", c.ct,
-                        sliceSpacing_mm > 0 ? fmt::format("{:g} mm slices", sliceSpacing_mm) : "original slices",
-                        c.viewCount));
-    auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
-    if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
-    const std::vector<RegistrationView> views(scene.xrays.begin(), scene.xrays.begin() + c.viewCount);
-    auto created = RegistrationCase::create(registrationCt.value(), views, caseOptions);
-    if (!created) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, created.error()));
-    prototypes.emplace(key, std::make_unique<RegistrationCase>(std::move(created).value()));
-  }
-
-  std::map<StudyMeasures, RegistrationSchedule> schedules;
-  for (StudyMeasures m : {StudyMeasures::Both, StudyMeasures::NccOnly, StudyMeasures::VlncOnly}) {
-    schedules.emplace(m, scheduleFor(baseSchedule.value(), m));
-  }
-
-  std::mutex mutex;
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> storeFailed{false};
-  std::string storeError;
-  int finished = 0;
-  const auto cancelled = [&] { return options.cancel && options.cancel->load(); };
-  const auto worker = [&] {
-    std::map<std::string, RegistrationCase> ownCases;
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= pending.size() || storeFailed.load() || cancelled()) return;
-      const StudyCondition& c = *pending[i].condition;
-      const std::string key = caseKey(c, *scenes.at(c.ct).ct);
-      auto found = ownCases.find(key);
-      if (found == ownCases.end()) {
-        found = ownCases.emplace(key, *prototypes.at(key)).first;
-      } else if (tablePerTrial) {
-        found->second = *prototypes.at(key);  // no tables yet: this trial builds (or loads) them around its start
-      }
-      TrialRecord record;
-      try {
-        record = runTrial(study, c, pending[i].trial, scenes.at(c.ct), found->second, schedules.at(c.measures),
-                          options.cancel);
-      } catch (const std::exception& e) {  // e.g. out of memory: this trial fails, the study goes on
-        record = failedTrial(study, c, pending[i].trial, fmt::format("unexpected error: {}", e.what()));
-      }
-      const std::lock_guard lock(mutex);
-      ++summary.ran;
-      if (record.status == TrialStatus::Failed) ++summary.failed;
-      if (record.status == TrialStatus::Cancelled) summary.cancelled = true;
-      if (Status saved = store.add(record); !saved && !storeFailed.exchange(true)) storeError = saved.error();
-      ++finished;
-      if (options.onTrial) options.onTrial(StudyProgress{finished, static_cast<int>(pending.size()), record});
-    }
-  };
-  const int threads = std::min<int>(options.jobs, static_cast<int>(pending.size()));
-  if (threads == 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
-    for (std::thread& thread : pool) thread.join();
-  }
-  if (storeFailed) return fail("cannot save the trials: " + storeError);
-  summary.cancelled = summary.cancelled || cancelled();
+  auto scenes = simulateScenes(study, cts, pending, options);
+  if (!scenes) return fail(scenes.error());
+  auto prototypes = prepareCases(study, pending, scenes.value(), options);
+  if (!prototypes) return fail(prototypes.error());
+  TrialWork work{study, pending, scenes.value(), prototypes.value(), schedulesFor(baseSchedule.value()), options,
+                 store, summary};
+  if (Status saved = runTrials(work); !saved) return fail(saved.error());
+  summary.cancelled = summary.cancelled || cancelRequested(options);
   return summary;
 }
 

@@ -95,75 +95,117 @@ Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) 
   return scene;
 }
 
-/// Renders one view of a prepared scene; the pose must already be checked rigid.
-Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
-                                const FluoroscopyOptions& options, std::uint32_t viewSeed) {
+/// Where one view's rays go: the source and camera rotation in the CT frame, the intrinsics, and the detector centre
+/// and collimator radius in pixels (0: no collimator).
+struct ViewGeometry {
+  CameraIntrinsics in;
+  Eigen::Matrix3d K;
+  Eigen::Vector3d source_ct;
+  Eigen::Matrix3d R_ct_from_camera;
+  Eigen::Vector2d centre_px;
+  double collimator_px = 0.0;
+};
+
+/// The ray geometry of `camera` with the CT at T_world_from_ct.
+ViewGeometry viewGeometry(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
+                          const FluoroscopyOptions& options) {
   const CameraIntrinsics& in = camera.intrinsics();
-  if (in.cols <= 0 || in.rows <= 0) return fail("camera has an empty detector; check the view file");
-  std::optional<IntensifierDistortion> distortion;
-  if (options.pincushion != 0.0 || options.sDistortion_deg != 0.0) {
-    auto created = IntensifierDistortion::create(in.cols, in.rows, options.pincushion, options.sDistortion_deg);
-    if (!created.ok()) return fail(created.error());
-    distortion = std::move(created).value();
-  }
-  ForeignObjectSet spheres;
-  if (options.calibrationSpheres) {
-    auto grid = ForeignObjectSet::calibrationGrid(camera, options.sphereSpacing_mm, options.sphereRadius_mm,
-                                                  options.sphereDistanceFromDetector_mm);
-    if (!grid.ok()) return fail(grid.error());
-    spheres = std::move(grid).value();
-  }
-
   const Eigen::Isometry3d T_ct_from_camera = T_world_from_ct.inverse() * camera.T_world_from_camera();
-  const Eigen::Vector3d source_ct = T_ct_from_camera.translation();
-  const Eigen::Matrix3d R_ct_from_camera = T_ct_from_camera.linear();
-  const Eigen::Matrix3d K = camera.K();
-  const Eigen::Vector2d centre_px(0.5 * (in.cols - 1), 0.5 * (in.rows - 1));
-  const double collimator_px = options.collimatorRadiusFraction * 0.5 * std::min(in.cols, in.rows);
-  const std::size_t binCount = scene.spectrum.bins().size();
-  std::vector<double> photonFraction(binCount), energyWeight(binCount);
-  double energyNorm = 0.0;
-  for (std::size_t b = 0; b < binCount; ++b) {
-    photonFraction[b] = scene.spectrum.bins()[b].photonFraction;
-    energyWeight[b] = photonFraction[b] * scene.spectrum.bins()[b].energy_keV;
-    energyNorm += energyWeight[b];
-  }
+  return {in,
+          camera.K(),
+          T_ct_from_camera.translation(),
+          T_ct_from_camera.linear(),
+          Eigen::Vector2d(0.5 * (in.cols - 1), 0.5 * (in.rows - 1)),
+          options.collimatorRadiusFraction * 0.5 * std::min(in.cols, in.rows)};
+}
 
-  // Pass 1: exact material path integrals and the noiseless signal of every pixel inside the collimator.
-  RenderedView view;
-  view.image = FloatImage::filled(in.cols, in.rows);
-  const std::size_t pixelCount = static_cast<std::size_t>(in.cols) * in.rows;
-  std::vector<MassPaths> pixelPaths(pixelCount);
-  std::vector<std::uint8_t> exposed(pixelCount, 0);
-  const auto transmissions = [&](const MassPaths& paths, std::vector<double>& transmission) {
-    double signal = 0.0;
-    for (std::size_t b = 0; b < binCount; ++b) {
-      double attenuation = 0.0;
-      for (int m = 0; m < kMaterialCount; ++m) attenuation += scene.massAttenuation_cm2_per_g[b][m] * paths[m];
-      transmission[b] = std::exp(-attenuation);
-      signal += energyWeight[b] * transmission[b];
-    }
-    return signal / energyNorm;
-  };
-  tbb::parallel_for(0, in.rows, [&](int row) {
-    std::vector<double> transmission(binCount);
-    for (int col = 0; col < in.cols; ++col) {
-      const std::size_t index = static_cast<std::size_t>(row) * in.cols + col;
-      if (collimator_px > 0.0 && (Eigen::Vector2d(col, row) - centre_px).norm() > collimator_px) continue;
+/// The spectrum bins' photon fractions and energy weights (photon fraction × keV) with the weights' sum.
+struct SpectrumWeights {
+  std::vector<double> photonFraction;
+  std::vector<double> energyWeight;
+  double energyNorm = 0.0;
+};
+
+/// The weights of the scene's spectrum.
+SpectrumWeights spectrumWeights(const XraySpectrum& spectrum) {
+  const std::size_t binCount = spectrum.bins().size();
+  SpectrumWeights w{std::vector<double>(binCount), std::vector<double>(binCount), 0.0};
+  for (std::size_t b = 0; b < binCount; ++b) {
+    w.photonFraction[b] = spectrum.bins()[b].photonFraction;
+    w.energyWeight[b] = w.photonFraction[b] * spectrum.bins()[b].energy_keV;
+    w.energyNorm += w.energyWeight[b];
+  }
+  return w;
+}
+
+/// The noiseless energy-integrating signal of a ray with these mass paths (1 = unattenuated); also fills each bin's
+/// transmission.
+double noiselessSignal(const Scene& scene, const SpectrumWeights& w, const MassPaths& paths,
+                       std::vector<double>& transmission) {
+  double signal = 0.0;
+  for (std::size_t b = 0; b < transmission.size(); ++b) {
+    double attenuation = 0.0;
+    for (int m = 0; m < kMaterialCount; ++m) attenuation += scene.massAttenuation_cm2_per_g[b][m] * paths[m];
+    transmission[b] = std::exp(-attenuation);
+    signal += w.energyWeight[b] * transmission[b];
+  }
+  return signal / w.energyNorm;
+}
+
+/// The intensifier distortion the options ask for; none when pincushion and S-distortion are 0.
+Result<std::optional<IntensifierDistortion>> distortionFor(const CameraIntrinsics& in,
+                                                           const FluoroscopyOptions& options) {
+  if (options.pincushion == 0.0 && options.sDistortion_deg == 0.0) return std::optional<IntensifierDistortion>();
+  auto created = IntensifierDistortion::create(in.cols, in.rows, options.pincushion, options.sDistortion_deg);
+  if (!created.ok()) return fail(created.error());
+  return std::optional<IntensifierDistortion>(std::move(created).value());
+}
+
+/// The calibration-grid spheres of `camera` (camera frame); an empty set when the options have none.
+Result<ForeignObjectSet> calibrationSpheresFor(const Camera& camera, const FluoroscopyOptions& options) {
+  if (!options.calibrationSpheres) return ForeignObjectSet();
+  return ForeignObjectSet::calibrationGrid(camera, options.sphereSpacing_mm, options.sphereRadius_mm,
+                                           options.sphereDistanceFromDetector_mm);
+}
+
+/// Per pixel (row-major): the mass paths of its ray, and whether the collimator lets it through.
+struct LineIntegrals {
+  std::vector<MassPaths> pixelPaths;
+  std::vector<std::uint8_t> exposed;
+};
+
+/// Pass 1: exact material path integrals through the CT, the implants and the spheres for every pixel inside the
+/// collimator, with their noiseless signal written to `image` (pixels outside stay 0).
+LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, const ForeignObjectSet& spheres,
+                                 const SpectrumWeights& weights, FloatImage& image) {
+  const std::size_t pixelCount = static_cast<std::size_t>(g.in.cols) * g.in.rows;
+  LineIntegrals rays{std::vector<MassPaths>(pixelCount), std::vector<std::uint8_t>(pixelCount, 0)};
+  tbb::parallel_for(0, g.in.rows, [&](int row) {
+    std::vector<double> transmission(weights.energyWeight.size());
+    for (int col = 0; col < g.in.cols; ++col) {
+      const std::size_t index = static_cast<std::size_t>(row) * g.in.cols + col;
+      if (g.collimator_px > 0.0 && (Eigen::Vector2d(col, row) - g.centre_px).norm() > g.collimator_px) continue;
       const Eigen::Vector3d direction_camera =
-          Eigen::Vector3d((col - K(0, 2)) / K(0, 0), (row - K(1, 2)) / K(1, 1), 1.0).normalized();
-      const Eigen::Vector3d direction_ct = R_ct_from_camera * direction_camera;
-      MassPaths& paths = pixelPaths[index];
-      paths = scene.tracer.trace(source_ct, direction_ct);
-      scene.implants.accumulate(source_ct, direction_ct, paths);
+          Eigen::Vector3d((col - g.K(0, 2)) / g.K(0, 0), (row - g.K(1, 2)) / g.K(1, 1), 1.0).normalized();
+      const Eigen::Vector3d direction_ct = g.R_ct_from_camera * direction_camera;
+      MassPaths& paths = rays.pixelPaths[index];
+      paths = scene.tracer.trace(g.source_ct, direction_ct);
+      scene.implants.accumulate(g.source_ct, direction_ct, paths);
       spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
       for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
-      view.image.pixels[index] = static_cast<float>(transmissions(paths, transmission));
-      exposed[index] = 1;
+      image.pixels[index] = static_cast<float>(noiselessSignal(scene, weights, paths, transmission));
+      rays.exposed[index] = 1;
     }
   });
+  return rays;
+}
+
+/// Sets the view's maxLineIntegral and referenceSignal (automatic exposure: the 99th percentile of the exposed
+/// noiseless signals; else 1) from its noiseless image. Fails when no pixel is exposed or no X-ray gets through.
+Status measureExposure(const std::vector<std::uint8_t>& exposed, const FluoroscopyOptions& options,
+                       RenderedView& view) {
   std::vector<float> field;
-  for (std::size_t index = 0; index < pixelCount; ++index) {
+  for (std::size_t index = 0; index < exposed.size(); ++index) {
     if (exposed[index]) field.push_back(view.image.pixels[index]);
   }
   if (field.empty()) return fail("the collimator leaves no pixel exposed; raise the collimator radius");
@@ -175,59 +217,82 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
     if (!(*reference > 1e-30f)) return fail("no X-ray reaches the detector through this CT; check the pose and views");
     view.referenceSignal = *reference;
   }
+  return Ok{};
+}
 
-  // Pass 2: exposure scaling and Poisson quantum noise per energy bin.
-  const double photons = options.photonsPerPixel / view.referenceSignal;
-  tbb::parallel_for(0, in.rows, [&](int row) {
+/// Pass 2: exposure scaling of every exposed pixel by the reference signal and, with a dose, Poisson quantum noise per
+/// energy bin (one random stream per row, from viewSeed).
+void exposeWithQuantumNoise(const Scene& scene, const SpectrumWeights& weights, const LineIntegrals& rays,
+                            const FluoroscopyOptions& options, std::uint32_t viewSeed, double referenceSignal,
+                            FloatImage& image) {
+  const double photons = options.photonsPerPixel / referenceSignal;
+  tbb::parallel_for(0, image.rows, [&](int row) {
     SeededRandom random(SeededRandom::streamSeed(viewSeed, static_cast<std::uint32_t>(row)));
-    std::vector<double> transmission(binCount);
-    for (int col = 0; col < in.cols; ++col) {
-      const std::size_t index = static_cast<std::size_t>(row) * in.cols + col;
-      if (!exposed[index]) continue;
-      float& out = view.image.pixels[index];
+    std::vector<double> transmission(weights.energyWeight.size());
+    for (int col = 0; col < image.cols; ++col) {
+      const std::size_t index = static_cast<std::size_t>(row) * image.cols + col;
+      if (!rays.exposed[index]) continue;
+      float& out = image.pixels[index];
       if (options.photonsPerPixel == 0.0) {
-        out = static_cast<float>(out / view.referenceSignal);
+        out = static_cast<float>(out / referenceSignal);
         continue;
       }
-      transmissions(pixelPaths[index], transmission);
+      noiselessSignal(scene, weights, rays.pixelPaths[index], transmission);
       double energy = 0.0;
-      for (std::size_t b = 0; b < binCount; ++b) {
-        energy += static_cast<double>(random.poisson(photons * photonFraction[b] * transmission[b])) *
+      for (std::size_t b = 0; b < transmission.size(); ++b) {
+        energy += static_cast<double>(random.poisson(photons * weights.photonFraction[b] * transmission[b])) *
                   scene.spectrum.bins()[b].energy_keV;
       }
-      out = static_cast<float>(energy / (options.photonsPerPixel * energyNorm));
+      out = static_cast<float>(energy / (options.photonsPerPixel * weights.energyNorm));
     }
   });
+}
 
-  if (options.psfSigma_px > 0.0) {
-    try {
-      cv::Mat image(in.rows, in.cols, CV_32F, view.image.pixels.data());
-      cv::GaussianBlur(image, image, cv::Size(0, 0), options.psfSigma_px, options.psfSigma_px, cv::BORDER_REPLICATE);
-    } catch (const cv::Exception& e) {
-      return fail(fmt::format("point-spread blur failed: {}", e.what()));
-    }
+/// The detector's point-spread function: a Gaussian blur of sigma_px (0: none), in place. Fails on an OpenCV error.
+Status blurPointSpread(double sigma_px, FloatImage& image) {
+  if (sigma_px <= 0.0) return Ok{};
+  try {
+    cv::Mat mat(image.rows, image.cols, CV_32F, image.pixels.data());
+    cv::GaussianBlur(mat, mat, cv::Size(0, 0), sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("point-spread blur failed: {}", e.what()));
   }
-  if (distortion) {
-    auto warped = distortion->warp(view.image);
-    if (!warped.ok()) return fail(warped.error());
-    view.image = std::move(warped).value();
-    view.field = distortion->field();
-  }
+  return Ok{};
+}
+
+/// Warps the view's image by the intensifier distortion and keeps its displacement field.
+Status distortView(const IntensifierDistortion& distortion, RenderedView& view) {
+  auto warped = distortion.warp(view.image);
+  if (!warped.ok()) return fail(warped.error());
+  view.image = std::move(warped).value();
+  view.field = distortion.field();
+  return Ok{};
+}
+
+/// The detector's grey values: offset + gain × (vignetting × signal)^gamma, vignetting falling off with the squared
+/// distance from centre_px, in place.
+void applyDetectorResponse(const FluoroscopyOptions& options, const Eigen::Vector2d& centre_px, FloatImage& image) {
   const double halfDiagonal2 = centre_px.squaredNorm();
-  tbb::parallel_for(0, in.rows, [&](int row) {
-    for (int col = 0; col < in.cols; ++col) {
+  tbb::parallel_for(0, image.rows, [&](int row) {
+    for (int col = 0; col < image.cols; ++col) {
       const double vignette =
           1.0 - options.vignetting * (Eigen::Vector2d(col, row) - centre_px).squaredNorm() / halfDiagonal2;
-      float& value = view.image.at(col, row);
+      float& value = image.at(col, row);
       value = static_cast<float>(options.offset +
                                  options.gain * std::pow(std::max(0.0, vignette * double(value)), options.gamma));
     }
   });
+}
 
+/// The observed shadow (centre and radius in pixels, after the distortion if any) of each calibration sphere.
+std::vector<PixelCircle> sphereShadows(const ForeignObjectSet& spheres, const ViewGeometry& g,
+                                       const std::optional<IntensifierDistortion>& distortion) {
+  std::vector<PixelCircle> shadows;
   for (const ForeignObject& sphere : spheres.objects()) {
-    const Eigen::Vector3d uvw = K * sphere.a_mm;
+    const Eigen::Vector3d uvw = g.K * sphere.a_mm;
     Eigen::Vector2d centre = uvw.head<2>() / uvw.z();
-    const double radius_px = sphere.radius_mm * in.sourceToDetector_mm / sphere.a_mm.z() / in.pixelSpacing_mm.minCoeff();
+    const double radius_px =
+        sphere.radius_mm * g.in.sourceToDetector_mm / sphere.a_mm.z() / g.in.pixelSpacing_mm.minCoeff();
     double radius = radius_px;
     if (distortion) {
       const Eigen::Vector2d observed = distortion->distort(centre);
@@ -235,8 +300,34 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
                         (distortion->distort(centre + Eigen::Vector2d(0, radius_px)) - observed).norm());
       centre = observed;
     }
-    view.spheres.push_back({centre, radius});
+    shadows.push_back({centre, radius});
   }
+  return shadows;
+}
+
+/// Renders one view of a prepared scene; the pose must already be checked rigid. Fails on an empty detector, bad
+/// distortion or sphere settings, a collimator or pose that lets no X-ray through, or an image-processing error.
+Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
+                                const FluoroscopyOptions& options, std::uint32_t viewSeed) {
+  const ViewGeometry geometry = viewGeometry(camera, T_world_from_ct, options);
+  if (geometry.in.cols <= 0 || geometry.in.rows <= 0) return fail("camera has an empty detector; check the view file");
+  auto distortion = distortionFor(geometry.in, options);
+  if (!distortion.ok()) return fail(distortion.error());
+  auto spheres = calibrationSpheresFor(camera, options);
+  if (!spheres.ok()) return fail(spheres.error());
+  const SpectrumWeights weights = spectrumWeights(scene.spectrum);
+
+  RenderedView view;
+  view.image = FloatImage::filled(geometry.in.cols, geometry.in.rows);
+  const LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, view.image);
+  if (Status exposure = measureExposure(rays.exposed, options, view); !exposure) return fail(exposure.error());
+  exposeWithQuantumNoise(scene, weights, rays, options, viewSeed, view.referenceSignal, view.image);
+  if (Status blurred = blurPointSpread(options.psfSigma_px, view.image); !blurred) return fail(blurred.error());
+  if (distortion.value()) {
+    if (Status distorted = distortView(*distortion.value(), view); !distorted) return fail(distorted.error());
+  }
+  applyDetectorResponse(options, geometry.centre_px, view.image);
+  view.spheres = sphereShadows(spheres.value(), geometry, distortion.value());
   return view;
 }
 

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <utility>
 
 #include "Base/JsonDocument.h"
 #include "Base/SeededRandom.h"
@@ -91,6 +93,158 @@ Eigen::Vector3d jitter(const Eigen::Vector3d& direction, double maxAngle_rad, Se
   return Eigen::AngleAxisd(random.uniform(0.0, maxAngle_rad), side.normalized()) * direction;
 }
 
+/// Where implants go on a CT's bone: the bone centroid and the surface voxels nearest to it.
+struct ImplantSites {
+  Eigen::Vector3d centroid_mm = Eigen::Vector3d::Zero();  ///< LPS
+  std::vector<Eigen::Vector3i> surface;  ///< voxel indices: the half of the surface nearest the centroid
+};
+
+/// The bone centroid and surface voxels (bone with a non-bone 6-neighbour; the grid border counts as non-bone) of
+/// `ct`, keeping the half of the surface voxels nearest the centroid (where the C-arm looks). Fails when no voxel is
+/// bone.
+Result<ImplantSites> findImplantSites(const Volume& ct, double boneThreshold_hu) {
+  const Eigen::Vector3i& dims = ct.dims();
+  const auto isBone = [&](int i, int j, int k) {
+    return i >= 0 && j >= 0 && k >= 0 && i < dims.x() && j < dims.y() && k < dims.z() &&
+           ct.at(i, j, k) >= boneThreshold_hu;
+  };
+  Eigen::Vector3d sum_ijk = Eigen::Vector3d::Zero();
+  double boneCount = 0.0;
+  ImplantSites sites;
+  for (int k = 0; k < dims.z(); ++k) {
+    for (int j = 0; j < dims.y(); ++j) {
+      for (int i = 0; i < dims.x(); ++i) {
+        if (!isBone(i, j, k)) continue;
+        sum_ijk += Eigen::Vector3d(i, j, k);
+        boneCount += 1.0;
+        if (!isBone(i - 1, j, k) || !isBone(i + 1, j, k) || !isBone(i, j - 1, k) || !isBone(i, j + 1, k) ||
+            !isBone(i, j, k - 1) || !isBone(i, j, k + 1)) {
+          sites.surface.emplace_back(i, j, k);
+        }
+      }
+    }
+  }
+  if (sites.surface.empty()) {
+    return fail(fmt::format("no bone (voxels >= {} HU) to place K-wires, screws, a plate or gas pockets near; lower "
+                            "the bone threshold or drop the objects",
+                            boneThreshold_hu));
+  }
+  sites.centroid_mm = ct.lpsFromIjk(sum_ijk / boneCount);
+  const auto distance2 = [&](const Eigen::Vector3i& v) {
+    return (ct.lpsFromIjk(v.cast<double>()) - sites.centroid_mm).squaredNorm();
+  };
+  const auto middle = sites.surface.begin() + static_cast<std::ptrdiff_t>(sites.surface.size() / 2);
+  std::nth_element(sites.surface.begin(), middle, sites.surface.end(),
+                   [&](const Eigen::Vector3i& a, const Eigen::Vector3i& b) { return distance2(a) < distance2(b); });
+  sites.surface.erase(middle + 1, sites.surface.end());
+  return sites;
+}
+
+/// The centre (LPS mm) of a random one of the sites' surface voxels.
+Eigen::Vector3d randomSurfacePoint(const Volume& ct, const ImplantSites& sites, SeededRandom& random) {
+  return ct.lpsFromIjk(sites.surface[random.index(static_cast<int>(sites.surface.size()))].cast<double>());
+}
+
+/// The unit vector from the bone centroid to p_mm; a random one when p_mm is the centroid.
+Eigen::Vector3d outwardAt(const ImplantSites& sites, const Eigen::Vector3d& p_mm, SeededRandom& random) {
+  const Eigen::Vector3d v = p_mm - sites.centroid_mm;
+  return v.norm() > 1e-6 ? Eigen::Vector3d(v.normalized()) : randomUnit(random);
+}
+
+/// A steel K-wire (r 1 mm, 150 mm long) through a random surface point, pointing outward ±30°, tip 25 mm inside.
+ForeignObject placeKwire(const Volume& ct, const ImplantSites& sites, SeededRandom& random) {
+  const Eigen::Vector3d p = randomSurfacePoint(ct, sites, random);
+  const Eigen::Vector3d dir = jitter(outwardAt(sites, p, random), M_PI / 6.0, random);
+  ForeignObject wire;
+  wire.kind = "kwire";
+  wire.shape = ForeignObject::Shape::Cylinder;
+  wire.material = Material::Iron;
+  wire.a_mm = p - 25.0 * dir;
+  wire.b_mm = p + 125.0 * dir;
+  wire.radius_mm = 1.0;
+  return wire;
+}
+
+/// A titanium screw at a random surface point pointing inward ±20°: its shaft (r 2.25 mm, 40 mm into the bone) and
+/// its head (r 4 mm, 3.5 mm outside the surface).
+std::pair<ForeignObject, ForeignObject> placeScrew(const Volume& ct, const ImplantSites& sites, SeededRandom& random) {
+  const Eigen::Vector3d p = randomSurfacePoint(ct, sites, random);
+  const Eigen::Vector3d dir = jitter(-outwardAt(sites, p, random), M_PI / 9.0, random);
+  ForeignObject shaft;
+  shaft.kind = "screw_shaft";
+  shaft.shape = ForeignObject::Shape::Cylinder;
+  shaft.material = Material::Titanium;
+  shaft.density_g_per_cm3 = MassAttenuationTable::density_g_per_cm3(Material::Titanium);
+  shaft.a_mm = p;
+  shaft.b_mm = p + 40.0 * dir;
+  shaft.radius_mm = 2.25;
+  ForeignObject head = shaft;
+  head.kind = "screw_head";
+  head.a_mm = p - 3.5 * dir;
+  head.b_mm = p;
+  head.radius_mm = 4.0;
+  return {shaft, head};
+}
+
+/// A steel plate (100 × 12 × 3.5 mm) lying on a random surface point, its long axis along the CT's k axis (its i axis
+/// when k is nearly along the surface normal).
+ForeignObject placePlate(const Volume& ct, const ImplantSites& sites, SeededRandom& random) {
+  const Eigen::Vector3d p = randomSurfacePoint(ct, sites, random);
+  const Eigen::Vector3d normal = outwardAt(sites, p, random);
+  Eigen::Vector3d along = ct.direction_lps().col(2) - normal * normal.dot(ct.direction_lps().col(2));
+  if (along.norm() < 0.1) along = ct.direction_lps().col(0) - normal * normal.dot(ct.direction_lps().col(0));
+  along.normalize();
+  ForeignObject plate;
+  plate.kind = "plate";
+  plate.shape = ForeignObject::Shape::Box;
+  plate.material = Material::Iron;
+  plate.axes.col(0) = along;
+  plate.axes.col(1) = normal.cross(along);
+  plate.axes.col(2) = normal;
+  plate.halfExtent_mm = Eigen::Vector3d(50.0, 6.0, 1.75);
+  plate.a_mm = p + normal * 2.0;
+  return plate;
+}
+
+/// True when the voxel nearest p_mm (LPS) is inside the grid and soft tissue (-200..300 HU, exclusive).
+bool isSoftTissue(const Volume& ct, const Eigen::Vector3d& p_mm) {
+  const Eigen::Vector3i ijk = ct.ijkFromLps(p_mm).array().round().cast<int>();
+  if ((ijk.array() < 0).any() || (ijk.array() >= ct.dims().array()).any()) return false;
+  const float hu = ct.at(ijk.x(), ijk.y(), ijk.z());
+  return hu > -200.0f && hu < 300.0f;
+}
+
+/// A gas pocket: of up to 500 random spheres (r 8..20 mm, centre within 100 mm of centroid_mm), the first whose centre
+/// and 26 surface points all lie in soft tissue; none when no attempt fits.
+std::optional<ForeignObject> placeGasPocket(const Volume& ct, const Eigen::Vector3d& centroid_mm,
+                                            SeededRandom& random) {
+  for (int attempt = 0; attempt < 500; ++attempt) {
+    const Eigen::Vector3d centre = centroid_mm + randomUnit(random) * random.uniform(0.0, 100.0);
+    const double radius = random.uniform(8.0, 20.0);
+    bool placed = isSoftTissue(ct, centre);
+    for (int a = -1; a <= 1 && placed; ++a) {
+      for (int b = -1; b <= 1 && placed; ++b) {
+        for (int c = -1; c <= 1 && placed; ++c) {
+          if (a != 0 || b != 0 || c != 0) {
+            placed = isSoftTissue(ct, centre + radius * Eigen::Vector3d(a, b, c).normalized());
+          }
+        }
+      }
+    }
+    if (placed) {
+      ForeignObject pocket;
+      pocket.kind = "gas_pocket";
+      pocket.shape = ForeignObject::Shape::Sphere;
+      pocket.material = Material::SoftTissue;
+      pocket.density_g_per_cm3 = -1.0;
+      pocket.a_mm = centre;
+      pocket.radius_mm = radius;
+      return pocket;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const ImplantOptions& options) {
@@ -101,128 +255,21 @@ Result<ForeignObjectSet> ForeignObjectSet::placeNearBone(const Volume& ct, const
   }
   ForeignObjectSet set;
   if (options.kwireCount == 0 && options.screwCount == 0 && !options.plate && options.gasPocketCount == 0) return set;
+  auto bone = findImplantSites(ct, options.boneThreshold_hu);
+  if (!bone.ok()) return fail(bone.error());
 
-  // Bone centroid and surface voxels (bone with a non-bone 6-neighbour; the grid border counts as non-bone).
-  const Eigen::Vector3i& dims = ct.dims();
-  const auto isBone = [&](int i, int j, int k) {
-    return i >= 0 && j >= 0 && k >= 0 && i < dims.x() && j < dims.y() && k < dims.z() &&
-           ct.at(i, j, k) >= options.boneThreshold_hu;
-  };
-  Eigen::Vector3d sum_ijk = Eigen::Vector3d::Zero();
-  double boneCount = 0.0;
-  std::vector<Eigen::Vector3i> surface;
-  for (int k = 0; k < dims.z(); ++k) {
-    for (int j = 0; j < dims.y(); ++j) {
-      for (int i = 0; i < dims.x(); ++i) {
-        if (!isBone(i, j, k)) continue;
-        sum_ijk += Eigen::Vector3d(i, j, k);
-        boneCount += 1.0;
-        if (!isBone(i - 1, j, k) || !isBone(i + 1, j, k) || !isBone(i, j - 1, k) || !isBone(i, j + 1, k) ||
-            !isBone(i, j, k - 1) || !isBone(i, j, k + 1)) {
-          surface.emplace_back(i, j, k);
-        }
-      }
-    }
-  }
-  if (surface.empty()) {
-    return fail(fmt::format("no bone (voxels >= {} HU) to place K-wires, screws, a plate or gas pockets near; lower "
-                            "the bone threshold or drop the objects",
-                            options.boneThreshold_hu));
-  }
-  const Eigen::Vector3d centroid_mm = ct.lpsFromIjk(sum_ijk / boneCount);
-  // Keep the surface near the bone centroid (where the C-arm looks): the nearest half of the surface voxels.
-  const auto distance2 = [&](const Eigen::Vector3i& v) { return (ct.lpsFromIjk(v.cast<double>()) - centroid_mm).squaredNorm(); };
-  const auto middle = surface.begin() + static_cast<std::ptrdiff_t>(surface.size() / 2);
-  std::nth_element(surface.begin(), middle, surface.end(),
-                   [&](const Eigen::Vector3i& a, const Eigen::Vector3i& b) { return distance2(a) < distance2(b); });
-  surface.erase(middle + 1, surface.end());
   SeededRandom random(options.seed);
-  const auto surfacePoint = [&] { return ct.lpsFromIjk(surface[random.index(static_cast<int>(surface.size()))].cast<double>()); };
-  const auto outward = [&](const Eigen::Vector3d& p_mm) {
-    const Eigen::Vector3d v = p_mm - centroid_mm;
-    return v.norm() > 1e-6 ? Eigen::Vector3d(v.normalized()) : randomUnit(random);
-  };
-
-  for (int n = 0; n < options.kwireCount; ++n) {
-    const Eigen::Vector3d p = surfacePoint();
-    const Eigen::Vector3d dir = jitter(outward(p), M_PI / 6.0, random);
-    ForeignObject wire;
-    wire.kind = "kwire";
-    wire.shape = ForeignObject::Shape::Cylinder;
-    wire.material = Material::Iron;
-    wire.a_mm = p - 25.0 * dir;
-    wire.b_mm = p + 125.0 * dir;
-    wire.radius_mm = 1.0;
-    set.m_objects.push_back(wire);
-  }
+  for (int n = 0; n < options.kwireCount; ++n) set.m_objects.push_back(placeKwire(ct, bone.value(), random));
   for (int n = 0; n < options.screwCount; ++n) {
-    const Eigen::Vector3d p = surfacePoint();
-    const Eigen::Vector3d dir = jitter(-outward(p), M_PI / 9.0, random);
-    ForeignObject shaft;
-    shaft.kind = "screw_shaft";
-    shaft.shape = ForeignObject::Shape::Cylinder;
-    shaft.material = Material::Titanium;
-    shaft.density_g_per_cm3 = MassAttenuationTable::density_g_per_cm3(Material::Titanium);
-    shaft.a_mm = p;
-    shaft.b_mm = p + 40.0 * dir;
-    shaft.radius_mm = 2.25;
-    ForeignObject head = shaft;
-    head.kind = "screw_head";
-    head.a_mm = p - 3.5 * dir;
-    head.b_mm = p;
-    head.radius_mm = 4.0;
+    const auto [shaft, head] = placeScrew(ct, bone.value(), random);
     set.m_objects.push_back(shaft);
     set.m_objects.push_back(head);
   }
-  if (options.plate) {
-    const Eigen::Vector3d p = surfacePoint();
-    const Eigen::Vector3d normal = outward(p);
-    Eigen::Vector3d along = ct.direction_lps().col(2) - normal * normal.dot(ct.direction_lps().col(2));
-    if (along.norm() < 0.1) along = ct.direction_lps().col(0) - normal * normal.dot(ct.direction_lps().col(0));
-    along.normalize();
-    ForeignObject plate;
-    plate.kind = "plate";
-    plate.shape = ForeignObject::Shape::Box;
-    plate.material = Material::Iron;
-    plate.axes.col(0) = along;
-    plate.axes.col(1) = normal.cross(along);
-    plate.axes.col(2) = normal;
-    plate.halfExtent_mm = Eigen::Vector3d(50.0, 6.0, 1.75);
-    plate.a_mm = p + normal * 2.0;
-    set.m_objects.push_back(plate);
-  }
-  // Gas pockets: random spheres whose centre and 26 surface points all lie in soft tissue.
-  const auto isSoftTissue = [&](const Eigen::Vector3d& p_mm) {
-    const Eigen::Vector3i ijk = ct.ijkFromLps(p_mm).array().round().cast<int>();
-    if ((ijk.array() < 0).any() || (ijk.array() >= dims.array()).any()) return false;
-    const float hu = ct.at(ijk.x(), ijk.y(), ijk.z());
-    return hu > -200.0f && hu < 300.0f;
-  };
+  if (options.plate) set.m_objects.push_back(placePlate(ct, bone.value(), random));
   for (int n = 0; n < options.gasPocketCount; ++n) {
-    bool placed = false;
-    for (int attempt = 0; attempt < 500 && !placed; ++attempt) {
-      const Eigen::Vector3d centre = centroid_mm + randomUnit(random) * random.uniform(0.0, 100.0);
-      const double radius = random.uniform(8.0, 20.0);
-      placed = isSoftTissue(centre);
-      for (int a = -1; a <= 1 && placed; ++a) {
-        for (int b = -1; b <= 1 && placed; ++b) {
-          for (int c = -1; c <= 1 && placed; ++c) {
-            if (a != 0 || b != 0 || c != 0) placed = isSoftTissue(centre + radius * Eigen::Vector3d(a, b, c).normalized());
-          }
-        }
-      }
-      if (placed) {
-        ForeignObject pocket;
-        pocket.kind = "gas_pocket";
-        pocket.shape = ForeignObject::Shape::Sphere;
-        pocket.material = Material::SoftTissue;
-        pocket.density_g_per_cm3 = -1.0;
-        pocket.a_mm = centre;
-        pocket.radius_mm = radius;
-        set.m_objects.push_back(pocket);
-      }
-    }
-    if (!placed) return fail("found no soft tissue near the bone for a gas pocket; remove the gas pockets for this CT");
+    const std::optional<ForeignObject> pocket = placeGasPocket(ct, bone.value().centroid_mm, random);
+    if (!pocket) return fail("found no soft tissue near the bone for a gas pocket; remove the gas pockets for this CT");
+    set.m_objects.push_back(*pocket);
   }
   return set;
 }
