@@ -155,6 +155,13 @@ void readAutosaveOwner(const JsonReader& reader, SessionContent& content) {
   }
 }
 
+/// The message for an input of the session that cannot be loaded: which one, why, and how to bring it back.
+std::string unloadableInput(const SessionFile& file, const char* what, const char* restore, const char* key,
+                            const std::string& why) {
+  return fmt::format("{}: the session's {} cannot be loaded ({}); put {} back or edit {} in the session file",
+                     file.where, what, why, restore, key);
+}
+
 /// "ct": loads the CT at its path (and series). Fails naming the key, or telling how to bring the CT back.
 Status readCtSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
   JsonReader ct(section, file.where + ": ct");
@@ -163,11 +170,7 @@ Status readCtSection(const nlohmann::json& section, const SessionFile& file, Ses
   if (ct.has("series_uid")) options.seriesInstanceUid = ct.string("series_uid");
   if (!ct.ok()) return fail(ct.error());
   auto loaded = StudioDocument::readCt(resolvedPath(ctPath, file.folder), options);
-  if (!loaded) {
-    return fail(fmt::format("{}: the session's CT cannot be loaded ({}); put the CT back or edit ct.path in the "
-                            "session file",
-                            file.where, loaded.error()));
-  }
+  if (!loaded) return fail(unloadableInput(file, "CT", "the CT", "ct.path", loaded.error()));
   content.ct = std::move(loaded).value();
   return Ok{};
 }
@@ -195,11 +198,7 @@ Status readViewsSection(const nlohmann::json& section, const SessionFile& file, 
     const std::string viewFile = views.string("view_file");
     if (!views.ok()) return fail(views.error());
     auto loaded = StudioDocument::readViews(resolvedPath(viewFile, file.folder));
-    if (!loaded) {
-      return fail(fmt::format("{}: the session's views cannot be loaded ({}); put the files back or edit "
-                              "views.view_file in the session file",
-                              file.where, loaded.error()));
-    }
+    if (!loaded) return fail(unloadableInput(file, "views", "the files", "views.view_file", loaded.error()));
     content.views = std::move(loaded).value();
     return Ok{};
   }

@@ -1,6 +1,7 @@
 #pragma once
 // Analytic objectives for the optimizer tests, in scaled coordinates d = (p - target) / scales.
 
+#include <atomic>
 #include <cmath>
 
 #include "Search/PoseOptimizer.h"
@@ -15,6 +16,14 @@ inline PoseVector targetPose() {
   PoseVector t;
   t << 3.0, -2.0, 5.0, 10.0, -4.0, 7.0;
   return t;
+}
+
+/// `objective`, counting its calls in `calls` and raising `cancel` at call number `cancelAt` (a user pressing Cancel).
+inline PoseObjective cancellingAt(int cancelAt, PoseObjective objective, int& calls, std::atomic<bool>& cancel) {
+  return [cancelAt, objective = std::move(objective), &calls, &cancel](const PoseVector& p) {
+    if (++calls == cancelAt) cancel = true;
+    return objective(p);
+  };
 }
 
 /// Quadratic bowl with different curvatures per axis; minimum 0 at target.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 
 #include "Base/JsonDocument.h"
 #include "Registration/RegistrationResultJson.h"
@@ -12,14 +13,21 @@ namespace {
 
 using fct::RegistrationResultJson;
 
+/// A stage report with its schedule fields set.
+fct::StageReport stageReport(const std::string& name, fct::SimilarityMetric metric, int level,
+                             fct::SearchStrategy search) {
+  fct::StageReport stage;
+  stage.name = name;
+  stage.metric = metric;
+  stage.level = level;
+  stage.search = search;
+  return stage;
+}
+
 fct::RegistrationResult twoStageResult() {
   fct::RegistrationResult result;
   result.viewNames = {"ap", "lateral"};
-  fct::StageReport first;
-  first.name = "ncc-whole-1:16";
-  first.metric = fct::SimilarityMetric::Ncc;
-  first.level = 2;
-  first.search = fct::SearchStrategy::Genetic;
+  fct::StageReport first = stageReport("ncc-whole-1:16", fct::SimilarityMetric::Ncc, 2, fct::SearchStrategy::Genetic);
   first.drrs = 120;
   first.fallbackRays = 7;
   first.keptFraction = {0.5, 0.25};
@@ -39,11 +47,7 @@ fct::RegistrationResult fullResult() {
   r.T_world_from_ct = r.T_initial * Eigen::Translation3d(1.5, -0.25, 2.0);
   r.rotationCentre_ct_mm = {0.5, 1.5, -2.5};
   r.viewNames = {"ap", "lateral.2"};  // a dot in a view name is kept as is
-  fct::StageReport stage;
-  stage.name = "vlnc-rois-1:4";
-  stage.metric = fct::SimilarityMetric::Vlnc;
-  stage.level = 1;
-  stage.search = fct::SearchStrategy::Local;
+  fct::StageReport stage = stageReport("vlnc-rois-1:4", fct::SimilarityMetric::Vlnc, 1, fct::SearchStrategy::Local);
   stage.seconds = 1.25;
   stage.drrs = 4000;
   stage.fallbackRays = 3'000'000'000L;  // more than an int holds

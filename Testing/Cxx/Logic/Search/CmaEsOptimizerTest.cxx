@@ -77,10 +77,7 @@ TEST(CmaEsOptimizer, CancelReturnsBestSoFarMarkedCancelled) {
   const auto bowl = t::bowl(t::targetPose(), scales);
   std::atomic<bool> cancel{false};
   int calls = 0;
-  const fct::PoseObjective objective = [&](const PoseVector& p) {
-    if (++calls == 40) cancel = true;
-    return bowl(p);
-  };
+  const fct::PoseObjective objective = t::cancellingAt(40, bowl, calls, cancel);
   const auto result =
       CmaEsOptimizer().minimize(objective, PoseVector::Zero(), scales, fct::ProgressMonitor(nullptr, &cancel));
   ASSERT_TRUE(result.ok()) << result.error();

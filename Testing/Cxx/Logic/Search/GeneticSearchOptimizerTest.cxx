@@ -111,10 +111,7 @@ TEST(GeneticSearchOptimizer, CancelReturnsBestSoFarMarkedCancelled) {
   const auto objective = t::bumpyBowl(t::targetPose(), scales);
   std::atomic<bool> cancel{false};
   int calls = 0;
-  const fct::PoseObjective counting = [&](const PoseVector& p) {
-    if (++calls == 700) cancel = true;
-    return objective(p);
-  };
+  const fct::PoseObjective counting = t::cancellingAt(700, objective, calls, cancel);
   const PoseVector start = t::trappedStart(t::targetPose(), scales);
   const auto result = GeneticSearchOptimizer(bumpyOptions(3))
                           .minimize(counting, start, scales, fct::ProgressMonitor(nullptr, &cancel));

@@ -73,10 +73,7 @@ TEST(NelderMeadOptimizer, CancelReturnsBestSoFarMarkedCancelled) {
   std::atomic<bool> cancel{false};
   int calls = 0;
   const auto bowl = t::bowl(target, scales);
-  const fct::PoseObjective objective = [&](const PoseVector& p) {
-    if (++calls == 50) cancel = true;
-    return bowl(p);
-  };
+  const fct::PoseObjective objective = t::cancellingAt(50, bowl, calls, cancel);
   const PoseVector start = PoseVector::Zero();
   const auto result =
       NelderMeadOptimizer().minimize(objective, start, scales, fct::ProgressMonitor(nullptr, &cancel));

@@ -39,14 +39,20 @@ struct OptimizerTraits<fct::NelderMeadOptimizer> {
   }
 };
 
-template <>
-struct OptimizerTraits<fct::GeneticSearchOptimizer> {
+/// Traits of an optimizer with a random-number seed in its options.
+template <class Optimizer, class Options>
+struct SeededOptimizerTraits {
   static constexpr bool kSeeded = true;
-  static fct::GeneticSearchOptimizer make(std::uint32_t seed) {
-    fct::GeneticSearchOptions options;
+  static Optimizer make(std::uint32_t seed) {
+    Options options;
     options.seed = seed;
-    return fct::GeneticSearchOptimizer(options);
+    return Optimizer(options);
   }
+};
+
+template <>
+struct OptimizerTraits<fct::GeneticSearchOptimizer>
+    : SeededOptimizerTraits<fct::GeneticSearchOptimizer, fct::GeneticSearchOptions> {
   static constexpr const char* kBadOption = "random guess";
   static fct::GeneticSearchOptimizer withBadOption() {
     fct::GeneticSearchOptions options;
@@ -56,13 +62,7 @@ struct OptimizerTraits<fct::GeneticSearchOptimizer> {
 };
 
 template <>
-struct OptimizerTraits<fct::CmaEsOptimizer> {
-  static constexpr bool kSeeded = true;
-  static fct::CmaEsOptimizer make(std::uint32_t seed) {
-    fct::CmaEsOptions options;
-    options.seed = seed;
-    return fct::CmaEsOptimizer(options);
-  }
+struct OptimizerTraits<fct::CmaEsOptimizer> : SeededOptimizerTraits<fct::CmaEsOptimizer, fct::CmaEsOptions> {
   static constexpr const char* kBadOption = "population size";
   static fct::CmaEsOptimizer withBadOption() {
     fct::CmaEsOptions options;
@@ -94,10 +94,7 @@ TYPED_TEST(PoseOptimizerContract, CancelFlagStopsTheRunAndReturnsTheBestSoFar) {
   const auto bowl = t::bowl(this->target, this->scales);
   std::atomic<bool> cancel{false};
   int calls = 0;
-  const fct::PoseObjective objective = [&](const PoseVector& p) {
-    if (++calls == 30) cancel = true;
-    return bowl(p);
-  };
+  const fct::PoseObjective objective = t::cancellingAt(30, bowl, calls, cancel);
   const auto result =
       optimizer.minimize(objective, PoseVector::Zero(), this->scales, fct::ProgressMonitor(nullptr, &cancel));
   ASSERT_TRUE(result.ok()) << result.error();

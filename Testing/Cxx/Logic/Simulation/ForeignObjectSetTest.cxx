@@ -14,6 +14,14 @@ fct::Volume phantom() {
   options.spacing_mm = 4.0;
   return fct::PhantomBuilder::build(options).value();
 }
+
+/// An 8^3 volume of 2 mm voxels, all of one value (HU).
+fct::Volume uniformVolume(float value_hu) {
+  return fct::Volume::create(Eigen::Vector3i(8, 8, 8), Eigen::Vector3d::Constant(2.0), Eigen::Vector3d::Zero(),
+                             Eigen::Matrix3d::Identity(), value_hu)
+      .value();
+}
+
 }  // namespace
 
 TEST(ForeignObjectSet, GridSpheresGiveExactChordsAndProjectOntoTheDetector) {
@@ -79,10 +87,7 @@ TEST(ForeignObjectSet, PlacesImplantsOnTheBoneDeterministically) {
 }
 
 TEST(ForeignObjectSet, RejectsNoBoneAndBadSizes) {
-  const fct::Volume water =
-      fct::Volume::create(Eigen::Vector3i(8, 8, 8), Eigen::Vector3d::Constant(2.0), Eigen::Vector3d::Zero(),
-                          Eigen::Matrix3d::Identity(), 0.0f)
-          .value();
+  const fct::Volume water = uniformVolume(0.0f);
   fct::ImplantOptions options;
   options.kwireCount = 1;
   EXPECT_FALSE(fct::ForeignObjectSet::placeNearBone(water, options).ok());
@@ -99,10 +104,7 @@ TEST(ForeignObjectSet, RejectsNoBoneAndBadSizes) {
 }
 
 TEST(ForeignObjectSet, GasPocketsWithoutSoftTissueFailInTheModulesOwnWords) {
-  const fct::Volume bone =
-      fct::Volume::create(Eigen::Vector3i(8, 8, 8), Eigen::Vector3d::Constant(2.0), Eigen::Vector3d::Zero(),
-                          Eigen::Matrix3d::Identity(), 1000.0f)
-          .value();
+  const fct::Volume bone = uniformVolume(1000.0f);
   fct::ImplantOptions options;
   options.gasPocketCount = 1;
   const auto placed = fct::ForeignObjectSet::placeNearBone(bone, options);
