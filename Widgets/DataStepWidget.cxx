@@ -1,4 +1,4 @@
-#include "DataStepWidget.h"
+#include "Widgets/DataStepWidget.h"
 
 #include <fmt/core.h>
 
@@ -18,7 +18,7 @@
 #include <optional>
 
 #include "IO/Project/PoseFile.h"
-#include "StudioDocument.h"
+#include "Widgets/StudioDocument.h"
 
 namespace fct {
 

@@ -1,4 +1,4 @@
-#include "ImageViewWidget.h"
+#include "Widgets/ImageViewWidget.h"
 
 #include <QMouseEvent>
 #include <QPainter>

@@ -1,4 +1,4 @@
-#include "LandmarkStepWidget.h"
+#include "Widgets/LandmarkStepWidget.h"
 
 #include <QFileDialog>
 #include <QHBoxLayout>
@@ -16,9 +16,9 @@
 #include "Image/BoneSurface.h"
 #include "InitialPose/SetupPose.h"
 #include "IO/Project/LandmarkFile.h"
-#include "SliceViewWidget.h"
-#include "StudioDocument.h"
-#include "XrayViewWidget.h"
+#include "Widgets/SliceViewWidget.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace fct {
 

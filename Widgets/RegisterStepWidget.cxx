@@ -1,4 +1,4 @@
-#include "RegisterStepWidget.h"
+#include "Widgets/RegisterStepWidget.h"
 
 #include <QApplication>
 #include <QCheckBox>
@@ -17,8 +17,8 @@
 
 #include <fmt/format.h>
 
-#include "RegistrationWorker.h"
-#include "StudioDocument.h"
+#include "Widgets/RegistrationWorker.h"
+#include "Widgets/StudioDocument.h"
 
 namespace fct {
 

@@ -1,4 +1,4 @@
-#include "RegistrationWorker.h"
+#include "Widgets/RegistrationWorker.h"
 
 #include <chrono>
 #include <exception>

@@ -1,4 +1,4 @@
-#include "ReviewStepWidget.h"
+#include "Widgets/ReviewStepWidget.h"
 
 #include <QApplication>
 #include <QCheckBox>
@@ -21,8 +21,8 @@
 
 #include "IO/Project/ItkTransformFile.h"
 #include "IO/Project/PoseFile.h"
-#include "StudioDocument.h"
-#include "XrayViewWidget.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace fct {
 

@@ -1,4 +1,4 @@
-#include "RoiStepWidget.h"
+#include "Widgets/RoiStepWidget.h"
 
 #include <QApplication>
 #include <QButtonGroup>
@@ -20,7 +20,7 @@
 #include <cmath>
 #include <limits>
 
-#include "XrayViewWidget.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace fct {
 

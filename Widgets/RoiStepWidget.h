@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "Similarity/DynamicRoiSelector.h"
-#include "StudioDocument.h"
+#include "Widgets/StudioDocument.h"
 
 class QCheckBox;
 class QComboBox;

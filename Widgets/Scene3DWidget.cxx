@@ -1,4 +1,4 @@
-#include "Scene3DWidget.h"
+#include "Widgets/Scene3DWidget.h"
 
 #include <QGuiApplication>
 #include <QMouseEvent>
@@ -38,7 +38,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "StudioDocument.h"
+#include "Widgets/StudioDocument.h"
 
 namespace fct {
 

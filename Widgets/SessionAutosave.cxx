@@ -1,9 +1,9 @@
-#include "SessionAutosave.h"
+#include "Widgets/SessionAutosave.h"
 
 #include <QStandardPaths>
 
-#include "StudioDocument.h"
-#include "StudioSession.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/StudioSession.h"
 
 namespace fct {
 

@@ -1,4 +1,4 @@
-#include "SliceViewWidget.h"
+#include "Widgets/SliceViewWidget.h"
 
 #include <QWheelEvent>
 

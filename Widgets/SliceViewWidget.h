@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "Image/Volume.h"
-#include "ImageViewWidget.h"
+#include "Widgets/ImageViewWidget.h"
 
 namespace fct {
 

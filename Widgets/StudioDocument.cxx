@@ -1,4 +1,4 @@
-#include "StudioDocument.h"
+#include "Widgets/StudioDocument.h"
 
 #include <fmt/core.h>
 

@@ -1,4 +1,4 @@
-#include "StudioMainWindow.h"
+#include "Widgets/StudioMainWindow.h"
 
 #include <QApplication>
 #include <QCloseEvent>
@@ -15,17 +15,17 @@
 #include <QToolBox>
 #include <QVBoxLayout>
 
-#include "DataStepWidget.h"
-#include "LandmarkStepWidget.h"
-#include "RegisterStepWidget.h"
-#include "ReviewStepWidget.h"
-#include "RoiStepWidget.h"
-#include "Scene3DWidget.h"
-#include "SessionAutosave.h"
-#include "SliceViewWidget.h"
-#include "StudioDocument.h"
-#include "StudioSession.h"
-#include "XrayViewWidget.h"
+#include "Widgets/DataStepWidget.h"
+#include "Widgets/LandmarkStepWidget.h"
+#include "Widgets/RegisterStepWidget.h"
+#include "Widgets/ReviewStepWidget.h"
+#include "Widgets/RoiStepWidget.h"
+#include "Widgets/Scene3DWidget.h"
+#include "Widgets/SessionAutosave.h"
+#include "Widgets/SliceViewWidget.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/StudioSession.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace fct {
 

@@ -1,4 +1,4 @@
-#include "StudioSession.h"
+#include "Widgets/StudioSession.h"
 
 #include <fmt/core.h>
 

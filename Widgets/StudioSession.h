@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "Base/Result.h"
-#include "StudioDocument.h"
+#include "Widgets/StudioDocument.h"
 
 namespace fct {
 

@@ -1,4 +1,4 @@
-#include "XrayViewWidget.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace fct {
 

@@ -3,7 +3,7 @@
 // drag signals in detector pixels) that takes XrayImage frames.
 
 #include "Image/XrayImage.h"
-#include "ImageViewWidget.h"
+#include "Widgets/ImageViewWidget.h"
 
 namespace fct {
 

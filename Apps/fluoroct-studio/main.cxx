@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "DataStepWidget.h"
-#include "RegisterStepWidget.h"
-#include "StudioMainWindow.h"
+#include "Widgets/DataStepWidget.h"
+#include "Widgets/RegisterStepWidget.h"
+#include "Widgets/StudioMainWindow.h"
 
 namespace {
 

@@ -5,10 +5,10 @@
 
 #include <fstream>
 
-#include "DataStepWidget.h"
-#include "StudioDocument.h"
 #include "StudioTestCase.h"
 #include "TestSupport.h"
+#include "Widgets/DataStepWidget.h"
+#include "Widgets/StudioDocument.h"
 
 namespace {
 

@@ -6,9 +6,9 @@
 #include <QTableWidget>
 
 #include "IO/Project/LandmarkFile.h"
-#include "LandmarkStepWidget.h"
 #include "StepTestSession.h"
 #include "TestSupport.h"
+#include "Widgets/LandmarkStepWidget.h"
 
 TEST(LandmarkStepWidget, ClickedLandmarkPairsGiveAnInitialPoseWithin3mm) {
   fct::test::StepTestSession session(fct::test::smallPhantom());

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "Evaluation/PoseOffset.h"
-#include "RegisterStepWidget.h"
 #include "StepTestSession.h"
+#include "Widgets/RegisterStepWidget.h"
 
 namespace {
 

@@ -7,9 +7,9 @@
 #include "Evaluation/PoseOffset.h"
 #include "IO/Project/ItkTransformFile.h"
 #include "IO/Project/PoseFile.h"
-#include "ReviewStepWidget.h"
 #include "StepTestSession.h"
 #include "TestSupport.h"
+#include "Widgets/ReviewStepWidget.h"
 
 namespace {
 

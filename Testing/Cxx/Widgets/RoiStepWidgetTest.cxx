@@ -7,9 +7,9 @@
 
 #include <cmath>
 
-#include "RoiStepWidget.h"
 #include "Similarity/DynamicRoiSelector.h"
 #include "StepTestSession.h"
+#include "Widgets/RoiStepWidget.h"
 
 TEST(RoiStepWidget, RaisingTheThresholdSliderKeepsFewerPixelsInEveryView) {
   fct::test::StepTestSession session(fct::test::smallPhantom());

@@ -3,9 +3,9 @@
 #include <QOpenGLContext>
 #include <QTest>
 
-#include "Scene3DWidget.h"
-#include "StudioDocument.h"
 #include "StudioTestCase.h"
+#include "Widgets/Scene3DWidget.h"
+#include "Widgets/StudioDocument.h"
 
 namespace {
 

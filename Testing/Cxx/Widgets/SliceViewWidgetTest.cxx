@@ -5,7 +5,7 @@
 #include <QTest>
 #include <QWheelEvent>
 
-#include "SliceViewWidget.h"
+#include "Widgets/SliceViewWidget.h"
 
 namespace {
 

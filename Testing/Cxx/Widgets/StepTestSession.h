@@ -20,9 +20,9 @@
 #include "Image/BoneSurface.h"
 #include "Logic/RegistrationTestCase.h"
 #include "Simulation/PhantomBuilder.h"
-#include "SliceViewWidget.h"
-#include "StudioDocument.h"
-#include "XrayViewWidget.h"
+#include "Widgets/SliceViewWidget.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace fct::test {
 

@@ -4,9 +4,9 @@
 
 #include <fstream>
 
-#include "StudioDocument.h"
 #include "StudioTestCase.h"
 #include "TestSupport.h"
+#include "Widgets/StudioDocument.h"
 
 namespace {
 

@@ -12,14 +12,14 @@
 
 #include <fstream>
 
-#include "DataStepWidget.h"
-#include "SessionAutosave.h"
-#include "SliceViewWidget.h"
-#include "StudioDocument.h"
-#include "StudioMainWindow.h"
 #include "StudioTestCase.h"
 #include "TestSupport.h"
-#include "XrayViewWidget.h"
+#include "Widgets/DataStepWidget.h"
+#include "Widgets/SessionAutosave.h"
+#include "Widgets/SliceViewWidget.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/StudioMainWindow.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace {
 

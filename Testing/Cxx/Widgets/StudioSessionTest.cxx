@@ -7,10 +7,10 @@
 
 #include "Base/JsonDocument.h"
 #include "Registration/RegistrationResultJson.h"
-#include "StudioDocument.h"
-#include "StudioSession.h"
 #include "StudioTestCase.h"
 #include "TestSupport.h"
+#include "Widgets/StudioDocument.h"
+#include "Widgets/StudioSession.h"
 
 namespace {
 

@@ -9,12 +9,12 @@
 
 #include "IO/Project/ItkTransformFile.h"
 #include "IO/Volume/VolumeFileIO.h"
-#include "LandmarkStepWidget.h"
-#include "RegisterStepWidget.h"
-#include "ReviewStepWidget.h"
-#include "RoiStepWidget.h"
 #include "StepTestSession.h"
 #include "TestSupport.h"
+#include "Widgets/LandmarkStepWidget.h"
+#include "Widgets/RegisterStepWidget.h"
+#include "Widgets/ReviewStepWidget.h"
+#include "Widgets/RoiStepWidget.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <QTest>
 #include <QWheelEvent>
 
-#include "XrayViewWidget.h"
+#include "Widgets/XrayViewWidget.h"
 
 namespace {
 
