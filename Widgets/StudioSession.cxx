@@ -9,6 +9,7 @@
 
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
+#include "Base/NameTable.h"
 #include "IO/Project/PoseFile.h"
 #include "Registration/RegistrationResultJson.h"
 
@@ -39,24 +40,17 @@ fs::path resolvedPath(const std::string& stored, const fs::path& folder) {
   return path.is_absolute() ? path : (folder / path).lexically_normal();
 }
 
-std::string verdictName(ResultVerdict verdict) {
-  switch (verdict) {
-    case ResultVerdict::Accepted:
-      return "accepted";
-    case ResultVerdict::Rejected:
-      return "rejected";
-    case ResultVerdict::Undecided:
-      break;
-  }
-  return "undecided";
-}
+/// The session file's names of the user's verdicts.
+constexpr NameTable<ResultVerdict, 3> kVerdicts{{{"accepted", ResultVerdict::Accepted},
+                                                 {"rejected", ResultVerdict::Rejected},
+                                                 {"undecided", ResultVerdict::Undecided}}};
 
 ordered_json pose(const Eigen::Isometry3d& T) { return JsonDocument::array(T.matrix()); }
 
 /// The result object shared with RESULT.json, with the user's verdict added.
 ordered_json resultJson(const RegistrationResult& r, ResultVerdict verdict) {
   ordered_json json = RegistrationResultJson::write(r);
-  json["verdict"] = verdictName(verdict);
+  json["verdict"] = nameOf(verdict, kVerdicts);
   return json;
 }
 
@@ -133,15 +127,7 @@ struct SessionFile {
 /// Checks "format" and "version" (1 up to the version this program writes). Fails naming the file and key for another
 /// format or a newer version.
 Status checkHeader(JsonReader& reader) {
-  const std::string format = reader.string("format");
-  if (reader.ok() && format != kFormat) {
-    reader.rejectKey("format", fmt::format("is '{}', not '{}': this is not a FluoroCT Studio session file", format,
-                                           kFormat));
-  }
-  const int version = reader.integer("version", 1);
-  if (reader.ok() && version > kVersion) {
-    reader.rejectKey("version", fmt::format("is {}; this program reads version {} (update FluoroCT)", version, kVersion));
-  }
+  reader.formatVersion(kFormat, "Studio session file", kVersion);
   if (!reader.ok()) return fail(reader.error());
   return Ok{};
 }
@@ -295,16 +281,10 @@ Status readResultSection(const nlohmann::json& section, const SessionFile& file,
   const std::string where = file.where + ": result";
   JsonReader reader(section, where);
   const std::string verdictText = reader.string("verdict");
-  if (reader.ok()) {
-    if (verdictText == "accepted") {
-      content.verdict = ResultVerdict::Accepted;
-    } else if (verdictText == "rejected") {
-      content.verdict = ResultVerdict::Rejected;
-    } else if (verdictText == "undecided") {
-      content.verdict = ResultVerdict::Undecided;
-    } else {
-      reader.rejectKey("verdict", fmt::format("is '{}'; use accepted, rejected or undecided", verdictText));
-    }
+  if (const auto verdict = valueNamed(verdictText, kVerdicts)) {
+    content.verdict = *verdict;
+  } else if (reader.ok()) {
+    reader.rejectKey("verdict", fmt::format("is '{}'; use accepted, rejected or undecided", verdictText));
   }
   if (!reader.ok()) return fail(reader.error());
   auto result = RegistrationResultJson::read(section, where);

@@ -26,6 +26,10 @@ int reportError(const std::string& message) {
   return kExitError;
 }
 
+void printWarnings(const std::vector<std::string>& warnings) {
+  for (const std::string& warning : warnings) fmt::print(stderr, "warning: {}\n", warning);
+}
+
 bool parseDetectorSize(const std::string& text, int& cols, int& rows) {
   char separator = 0, trailing = 0;
   return std::sscanf(text.c_str(), "%d%c%d%c", &cols, &separator, &rows, &trailing) == 3 &&

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace fct::cli {
 
@@ -17,6 +18,9 @@ using CommandAction = std::function<int()>;
 
 /// Prints "error: <message>" as one line on stderr and returns kExitError.
 int reportError(const std::string& message);
+
+/// Prints each warning (e.g. of a Result) as one line "warning: <text>" on stderr.
+void printWarnings(const std::vector<std::string>& warnings);
 
 /// Parses a detector size "COLSxROWS" (e.g. "800x600", x or X) into pixels; false on anything else or a size below 1.
 bool parseDetectorSize(const std::string& text, int& cols, int& rows);

@@ -64,14 +64,14 @@ int runDrr(const DrrCommandOptions& options) {
     return reportError(fmt::format("output folder '{}' does not exist; create it first", out.parent_path().string()));
   }
   const auto method = DrrRendererFactory::parseMethod(options.method);
-  if (!method.ok()) return reportError(method.error());
+  if (!method.ok()) return reportError("--method: " + method.error());
   const auto valueKind = DrrVolume::parseValueKind(options.values);
-  if (!valueKind.ok()) return reportError(valueKind.error());
+  if (!valueKind.ok()) return reportError("--values: " + valueKind.error());
   if (options.level < 0) return reportError(fmt::format("--level must be 0 or more, got {}", options.level));
 
   auto views = ViewFile::read(options.views);
   if (!views.ok()) return reportError(views.error());
-  for (const auto& warning : views.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  printWarnings(views.warnings());
   std::vector<ViewSpec> selected = views.value();
   if (!options.view.empty()) {
     std::erase_if(selected, [&](const ViewSpec& v) { return v.name != options.view; });
@@ -90,7 +90,7 @@ int runDrr(const DrrCommandOptions& options) {
 
   const auto ct = CtLoader::load(options.ct);
   if (!ct.ok()) return reportError(ct.error());
-  for (const auto& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  printWarnings(ct.warnings());
   DrrValueOptions valueOptions;
   valueOptions.kind = valueKind.value();
   auto drrVolume = DrrVolume::create(ct.value(), valueOptions);
@@ -113,7 +113,7 @@ int runDrr(const DrrCommandOptions& options) {
     const auto renderer =
         DrrRendererFactory::createForView(prepared, rendererOptions, selected[n].camera, T_world_from_ct);
     if (!renderer.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, renderer.error()));
-    for (const auto& warning : renderer.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+    printWarnings(renderer.warnings());
     const auto start = std::chrono::steady_clock::now();
     const Status rendered = renderer.value()->render(selected[n].camera, T_world_from_ct, options.level, images[n]);
     if (!rendered.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, rendered.error()));

@@ -133,8 +133,12 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o) {
   for (const auto& [label, path] : paths) {
     fmt::print(stderr, "evaluate: loading CT {}\n", path.string());
     auto volume = CtLoader::load(path);
-    if (!volume) return fail(fmt::format("--ct {}: {}", path.string(), volume.error()));
-    for (const std::string& warning : volume.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+    if (!volume) {
+      // A CT of --ct has no label yet; the others come from the data folder.
+      return fail(fmt::format("{} {}: {}", label.empty() ? "--ct" : "FLUOROCT_DATA_DIR CT", path.string(),
+                              volume.error()));
+    }
+    printWarnings(volume.warnings());
     cts.push_back(StudyCt{label.empty() ? labelFor(path, cts) : label, std::move(volume).value()});
   }
   return cts;

@@ -83,7 +83,7 @@ nlohmann::ordered_json residualsJson(const LandmarkPoseEstimate& e) {
 Result<InitialPose> poseFromLandmarks(const std::string& path, const std::vector<RegistrationView>& views) {
   auto pairs = LandmarkPairFile::read(path);
   if (!pairs) return fail("--landmarks: " + pairs.error());
-  for (const std::string& warning : pairs.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  printWarnings(pairs.warnings());
   const LandmarkPairSet& set = pairs.value();
   std::map<std::string, Camera> cameras;
   for (const RegistrationView& view : views) cameras.emplace(view.name, view.camera);
@@ -135,14 +135,14 @@ Result<Inputs> readInputs(const Options& o) {
   }
   Inputs in;
   auto method = DrrRendererFactory::parseMethod(o.method);
-  if (!method) return fail(method.error());
+  if (!method) return fail("--method: " + method.error());
   in.method = method.value();
   auto schedule = RegistrationSchedule::resolve(o.preset);
-  if (!schedule) return fail(schedule.error());
+  if (!schedule) return fail("--preset: " + schedule.error());
   in.schedule = std::move(schedule).value();
   auto views = RegistrationViewLoader::load(o.views);
   if (!views) return fail("--views: " + views.error());
-  for (const std::string& warning : views.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  printWarnings(views.warnings());
   in.views = std::move(views).value();
   auto initial = initialPose(o, in.views);
   if (!initial) return fail(initial.error());
@@ -154,7 +154,7 @@ Result<Inputs> readInputs(const Options& o) {
   }
   auto ct = CtLoader::load(o.ct);
   if (!ct) return fail("--ct: " + ct.error());
-  for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  printWarnings(ct.warnings());
   in.ct = std::move(ct).value();
   return in;
 }
@@ -212,7 +212,7 @@ Result<RegistrationCase> prepareCase(const Options& o, const Inputs& in, const R
   }
   auto registrationCase = RegistrationCase::create(in.ct, in.views, options, ProgressMonitor(onTableProgress, cancel));
   if (onTableProgress && options.drr.method == DrrMethod::Transgraph) fmt::print(stderr, "\n");
-  for (const std::string& warning : registrationCase.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+  printWarnings(registrationCase.warnings());
   return registrationCase;
 }
 

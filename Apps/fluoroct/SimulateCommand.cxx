@@ -141,7 +141,7 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       if (!pose.ok()) return reportError(pose.error());
       auto ct = CtLoader::load(options->ct);
       if (!ct.ok()) return reportError(ct.error());
-      for (const std::string& warning : ct.warnings()) fmt::print(stderr, "warning: {}\n", warning);
+      printWarnings(ct.warnings());
       std::optional<Volume> registrationCt;
       if (options->ctSlice_mm > 0.0) {
         auto degraded = CtSliceDegrader::degrade(ct.value(), options->ctSlice_mm);
@@ -159,7 +159,7 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
                                                     options->out, ctSource);
       } else {
         auto method = DrrRendererFactory::parseMethod(options->method);
-        if (!method.ok()) return reportError(method.error());
+        if (!method.ok()) return reportError("--method: " + method.error());
         options->drr.method = method.value();
         options->drr.noisePhotons = options->noisePhotons;
         options->drr.seed = options->seed;

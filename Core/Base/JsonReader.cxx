@@ -134,6 +134,32 @@ Eigen::MatrixXd JsonReader::matrix(std::string_view key, int rows, int cols) {
   return result;
 }
 
+const nlohmann::json* JsonReader::array(std::string_view key, std::string_view what) {
+  const nlohmann::json* value = required(key);
+  if (!value || value->is_array()) return value;
+  rejectKey(key, fmt::format("must be {}, got {}", what, describe(*value)));
+  return nullptr;
+}
+
+const nlohmann::json* JsonReader::object(std::string_view key, std::string_view what) {
+  const nlohmann::json* value = required(key);
+  if (!value || value->is_object()) return value;
+  rejectKey(key, fmt::format("must be {}, got {}", what, describe(*value)));
+  return nullptr;
+}
+
+int JsonReader::formatVersion(std::string_view format, std::string_view kind, int newest) {
+  const std::string stored = string("format");
+  if (ok() && stored != format) {
+    rejectKey("format", fmt::format("is '{}', not '{}': this is not a FluoroCT {}", stored, format, kind));
+  }
+  const int version = integer("version", 1);
+  if (ok() && version > newest) {
+    rejectKey("version", fmt::format("is {}; this program reads versions 1 to {} (update FluoroCT)", version, newest));
+  }
+  return ok() ? version : 0;
+}
+
 void JsonReader::rejectKey(std::string_view key, std::string_view problem) {
   reject(fmt::format("key '{}' {}", key, problem));
 }

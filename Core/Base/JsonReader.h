@@ -37,6 +37,15 @@ class JsonReader {
   Eigen::VectorXd vector(std::string_view key, int size);
   /// A required array of `rows` arrays of `cols` finite numbers each (row-major); zeros after an error.
   Eigen::MatrixXd matrix(std::string_view key, int rows, int cols);
+  /// A required JSON array; `what` describes it in the message ("an array of stage reports"). nullptr after an error.
+  const nlohmann::json* array(std::string_view key, std::string_view what);
+  /// A required JSON object; `what` describes it in the message ("an object {<view>: fraction}"). nullptr after an
+  /// error.
+  const nlohmann::json* object(std::string_view key, std::string_view what);
+  /// The file-type keys of a FluoroCT file: "format" must be `format` and "version" a whole number from 1 to `newest`.
+  /// Returns the version; 0 after an error, which names the file type `kind` ("Studio session file") or says to
+  /// update FluoroCT for a newer version.
+  int formatVersion(std::string_view format, std::string_view kind, int newest);
 
   /// Records "<where>: key '<key>' <problem>" unless an error is already recorded.
   void rejectKey(std::string_view key, std::string_view problem);

@@ -4,27 +4,27 @@
 
 #include <cmath>
 
+#include "Base/NameTable.h"
 #include "Drr/SiddonRayCaster.h"
 #include "Drr/TransgraphRenderer.h"
 #include "Drr/TrilinearRayCaster.h"
 
 namespace fct {
 
+namespace {
+
+/// The names of the DRR methods on the command line and in files.
+constexpr NameTable<DrrMethod, 3> kMethods{
+    {{"raycast", DrrMethod::RayCast}, {"siddon", DrrMethod::Siddon}, {"transgraph", DrrMethod::Transgraph}}};
+
+}  // namespace
+
 Result<DrrMethod> DrrRendererFactory::parseMethod(std::string_view name) {
-  if (name == "raycast") return DrrMethod::RayCast;
-  if (name == "siddon") return DrrMethod::Siddon;
-  if (name == "transgraph") return DrrMethod::Transgraph;
+  if (const auto method = valueNamed(name, kMethods)) return *method;
   return fail(fmt::format("unknown DRR method '{}'; use 'siddon', 'raycast' or 'transgraph'", name));
 }
 
-std::string_view DrrRendererFactory::methodName(DrrMethod method) {
-  switch (method) {
-    case DrrMethod::RayCast: return "raycast";
-    case DrrMethod::Siddon: return "siddon";
-    case DrrMethod::Transgraph: return "transgraph";
-  }
-  return "unknown";
-}
+std::string_view DrrRendererFactory::methodName(DrrMethod method) { return nameOf(method, kMethods); }
 
 Result<std::unique_ptr<DrrRenderer>> DrrRendererFactory::create(std::shared_ptr<const DrrVolume> volume,
                                                                 const DrrRendererOptions& options) {

@@ -10,6 +10,8 @@
 #include <functional>
 #include <limits>
 
+#include "Base/NameTable.h"
+
 namespace fct {
 
 Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& options) {
@@ -110,14 +112,21 @@ void DrrVolume::findContentBox() {
   m_contentLast_ijk = box.last;
 }
 
+namespace {
+
+/// The names of the DRR value kinds on the command line and in files.
+constexpr NameTable<DrrValueKind, 2> kValueKinds{
+    {{"attenuation", DrrValueKind::Attenuation}, {"raw", DrrValueKind::Raw}}};
+
+}  // namespace
+
 Result<DrrValueKind> DrrVolume::parseValueKind(std::string_view name) {
-  if (name == "attenuation") return DrrValueKind::Attenuation;
-  if (name == "raw") return DrrValueKind::Raw;
+  if (const auto kind = valueNamed(name, kValueKinds)) return *kind;
   return fail(fmt::format("unknown DRR values '{}'; use 'attenuation' or 'raw'", name));
 }
 
 std::string_view DrrVolume::valueKindName(DrrValueKind kind) {
-  return kind == DrrValueKind::Raw ? "raw" : "attenuation";
+  return nameOf(kind, kValueKinds);
 }
 
 }  // namespace fct

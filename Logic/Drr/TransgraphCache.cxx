@@ -282,6 +282,7 @@ Result<Transgraph> TransgraphCache::buildOrLoad(const Volume& ct, const Camera& 
   if (std::filesystem::exists(file, ec)) {
     const auto start = std::chrono::steady_clock::now();
     auto entry = load(file, cacheKey, planned.value());
+    std::string unusable = entry ? std::string() : entry.error();
     if (entry) {
       TransgraphBuildInfo info;
       info.loadedFromCache = true;
@@ -289,12 +290,9 @@ Result<Transgraph> TransgraphCache::buildOrLoad(const Volume& ct, const Camera& 
       info.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       auto loaded = Transgraph::fromTable(entry.value().layout, std::move(entry.value().table), integrator, info);
       if (loaded) return loaded;
-      warnings.push_back(fmt::format("Transgraph cache file {} is unusable ({}); rebuilt it", file.string(),
-                                     loaded.error()));
-    } else {
-      warnings.push_back(fmt::format("Transgraph cache file {} is unusable ({}); rebuilt it", file.string(),
-                                     entry.error()));
+      unusable = loaded.error();
     }
+    warnings.push_back(fmt::format("Transgraph cache file {} is unusable ({}); rebuilt it", file.string(), unusable));
   }
 
   auto built = Transgraph::build(ct, view, T_world_from_ct, parameters, std::move(integrator), monitor);

@@ -2,20 +2,21 @@
 
 #include <fmt/format.h>
 
-#include <array>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <system_error>
 
+#include "Base/NameTable.h"
 #include "Base/TextFile.h"
 
 namespace fct {
 
 namespace {
 
-/// The CSV names of the statuses, in the order of the TrialStatus enumerators.
-constexpr std::array<std::string_view, 3> kStatusNames{"ok", "failed", "cancelled"};
+/// The CSV names of the statuses.
+constexpr NameTable<TrialStatus, 3> kStatusNames{
+    {{"ok", TrialStatus::Ok}, {"failed", TrialStatus::Failed}, {"cancelled", TrialStatus::Cancelled}}};
 
 std::string quoted(const std::string& field) {
   if (field.find_first_of(",\"\n\r") == std::string::npos) return field;
@@ -75,12 +76,10 @@ bool parseInt(const std::string& text, Int& out) {
 
 }  // namespace
 
-std::string_view trialStatusName(TrialStatus status) { return kStatusNames[static_cast<std::size_t>(status)]; }
+std::string_view trialStatusName(TrialStatus status) { return nameOf(status, kStatusNames); }
 
 Result<TrialStatus> parseTrialStatus(std::string_view text) {
-  for (std::size_t i = 0; i < kStatusNames.size(); ++i) {
-    if (text == kStatusNames[i]) return static_cast<TrialStatus>(i);
-  }
+  if (const auto status = valueNamed(text, kStatusNames)) return *status;
   return fail(fmt::format("unknown trial status '{}'; the status is ok, failed or cancelled", text));
 }
 

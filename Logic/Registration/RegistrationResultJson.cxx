@@ -45,8 +45,7 @@ std::string text(JsonReader& reader, std::string_view key) {
 /// The view names: the `view_names` array, or (version 1 without it) the first stage's kept_fraction keys.
 std::vector<std::string> readViewNames(JsonReader& reader, const nlohmann::json& object, int version) {
   std::vector<std::string> names;
-  const nlohmann::json* list = reader.find("view_names");
-  if (!list && version == 1) {
+  if (!reader.has("view_names") && version == 1) {
     const auto stages = object.find("stages");
     if (stages != object.end() && stages->is_array() && !stages->empty() && stages->front().is_object()) {
       const auto kept = stages->front().find("kept_fraction");
@@ -56,11 +55,8 @@ std::vector<std::string> readViewNames(JsonReader& reader, const nlohmann::json&
     }
     return names;
   }
-  if (!list || !list->is_array()) {
-    reader.rejectKey("view_names", list ? "must be an array of view names, got " + JsonReader::describe(*list)
-                                        : "is missing");
-    return names;
-  }
+  const nlohmann::json* list = reader.array("view_names", "an array of view names");
+  if (!list) return names;
   for (const nlohmann::json& name : *list) {
     if (!name.is_string()) {
       reader.rejectKey("view_names", "must hold only strings, got " + JsonReader::describe(name));
@@ -97,12 +93,7 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
   stage.evaluations = reader.integer("evaluations", 0);
   stage.startSimilarity = reader.number("start_similarity");
   stage.similarity = reader.number("similarity");
-  const nlohmann::json* kept = reader.find("kept_fraction");
-  if (reader.ok() && (!kept || !kept->is_object())) {
-    reader.rejectKey("kept_fraction", kept ? "must be an object {<view name>: fraction}, got " +
-                                                 JsonReader::describe(*kept)
-                                           : "is missing");
-  }
+  const nlohmann::json* kept = reader.object("kept_fraction", "an object {<view name>: fraction}");
   for (std::size_t v = 0; reader.ok() && v < views.size(); ++v) {
     const auto value = kept->find(views[v]);
     if (value == kept->end()) break;  // the writer leaves out nothing but fractions without a view name
@@ -161,19 +152,7 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
 
 Result<RegistrationResult> RegistrationResultJson::read(const nlohmann::json& object, const std::string& where) {
   JsonReader reader(object, where);
-  int version = 1;
-  if (reader.has("format")) {
-    const std::string format = reader.string("format");
-    if (reader.ok() && format != kFormat) {
-      reader.rejectKey("format", fmt::format("is '{}', not '{}': this is not a FluoroCT registration result", format,
-                                             kFormat));
-    }
-    version = reader.integer("version", 1);
-    if (reader.ok() && version > kVersion) {
-      reader.rejectKey("version", fmt::format("is {}; this program reads versions 1 to {} (update FluoroCT)", version,
-                                              kVersion));
-    }
-  }
+  const int version = reader.has("format") ? reader.formatVersion(kFormat, "registration result", kVersion) : 1;
   if (!reader.ok()) return fail(reader.error());
   const Keys& keys = version == 1 && reader.has("T_initial") ? kSessionVersion1Keys : kKeys;
 
@@ -187,11 +166,7 @@ Result<RegistrationResult> RegistrationResultJson::read(const nlohmann::json& ob
   r.totalDrrs = count(reader, "total_drrs");
   if (version >= 2) r.viewRendererSetupSeconds = reader.number("view_renderer_setup_seconds");
   r.drrMethod = text(reader, keys.method);
-  const nlohmann::json* stages = reader.find("stages");
-  if (reader.ok() && (!stages || !stages->is_array())) {
-    reader.rejectKey("stages", stages ? "must be an array of stage reports, got " + JsonReader::describe(*stages)
-                                      : "is missing");
-  }
+  const nlohmann::json* stages = reader.array("stages", "an array of stage reports");
   for (std::size_t i = 0; reader.ok() && i < stages->size(); ++i) {
     r.stages.push_back(readStage((*stages)[i], fmt::format("{}: stages[{}]", where, i), r.viewNames, reader));
   }

@@ -7,32 +7,14 @@
 
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
+#include "Base/NameTable.h"
 #include "RegistrationPresetsEmbedded.h"
 
 namespace fct {
 
 namespace {
 
-template <typename Enum, std::size_t N>
-using NameTable = std::array<std::pair<std::string_view, Enum>, N>;
-
-/// The value named `text`, or nullopt.
-template <typename Enum, std::size_t N>
-std::optional<Enum> valueNamed(std::string_view text, const NameTable<Enum, N>& names) {
-  for (const auto& [name, value] : names) {
-    if (text == name) return value;
-  }
-  return std::nullopt;
-}
-
-/// The names of a table, comma-separated.
-template <typename Enum, std::size_t N>
-std::string namesOf(const NameTable<Enum, N>& names) {
-  std::vector<std::string_view> accepted;
-  for (const auto& entry : names) accepted.push_back(entry.first);
-  return fmt::format("{}", fmt::join(accepted, ", "));
-}
-
+/// The value named by `key`; rejects the key (naming the accepted names) for any other text.
 template <typename Enum, std::size_t N>
 Enum parseName(JsonReader& reader, std::string_view key, const NameTable<Enum, N>& names) {
   const std::string text = reader.string(key);
@@ -42,11 +24,11 @@ Enum parseName(JsonReader& reader, std::string_view key, const NameTable<Enum, N
   return names[0].second;
 }
 
-constexpr std::array<std::pair<std::string_view, SimilarityMetric>, 3> kMetrics{
+constexpr NameTable<SimilarityMetric, 3> kMetrics{
     {{"ncc", SimilarityMetric::Ncc}, {"vlnc", SimilarityMetric::Vlnc}, {"gc", SimilarityMetric::GradientCorrelation}}};
-constexpr std::array<std::pair<std::string_view, SearchStrategy>, 3> kSearches{
+constexpr NameTable<SearchStrategy, 3> kSearches{
     {{"genetic", SearchStrategy::Genetic}, {"cmaes", SearchStrategy::CmaEs}, {"local", SearchStrategy::Local}}};
-constexpr std::array<std::pair<std::string_view, PixelSetKind>, 2> kPixelSets{
+constexpr NameTable<PixelSetKind, 2> kPixelSets{
     {{"whole", PixelSetKind::WholeImage}, {"rois", PixelSetKind::Rois}}};
 
 /// Reads an optional number into `value` (kept when the key is absent).
@@ -139,14 +121,6 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
     if (!status) return fail(fmt::format("{}: {}", where, status.error()));
   }
   return stage;
-}
-
-template <typename Enum, std::size_t N>
-std::string_view nameOf(Enum value, const std::array<std::pair<std::string_view, Enum>, N>& names) {
-  for (const auto& [name, v] : names) {
-    if (v == value) return name;
-  }
-  return "unknown";
 }
 
 }  // namespace

@@ -2,12 +2,12 @@
 
 #include <fmt/core.h>
 
-#include <array>
 #include <string>
 #include <utility>
 
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
+#include "Base/NameTable.h"
 #include "IO/Project/LandmarkFile.h"
 
 namespace fct {
@@ -16,17 +16,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::array<std::pair<std::string_view, LandmarkPoseMethod>, 2> kMethods{
+constexpr NameTable<LandmarkPoseMethod, 2> kMethods{
     {{"reprojection", LandmarkPoseMethod::Reprojection}, {"triangulation", LandmarkPoseMethod::Triangulation}}};
 
 }  // namespace
 
-std::string_view LandmarkPairFile::methodName(LandmarkPoseMethod method) {
-  for (const auto& [name, value] : kMethods) {
-    if (value == method) return name;
-  }
-  return kMethods.front().first;
-}
+std::string_view LandmarkPairFile::methodName(LandmarkPoseMethod method) { return nameOf(method, kMethods); }
 
 Result<LandmarkPairSet> LandmarkPairFile::read(const fs::path& path) {
   auto document = JsonDocument::parse(path);
@@ -38,14 +33,9 @@ Result<LandmarkPairSet> LandmarkPairFile::read(const fs::path& path) {
   set.imageFile = (folder / reader.string("image")).lexically_normal();
   if (reader.ok() && reader.has("method")) {
     const std::string method = reader.string("method");
-    bool known = false;
-    for (const auto& [name, value] : kMethods) {
-      if (method == name) {
-        set.method = value;
-        known = true;
-      }
-    }
-    if (reader.ok() && !known) {
+    if (const auto known = valueNamed(method, kMethods)) {
+      set.method = *known;
+    } else if (reader.ok()) {
       reader.rejectKey("method", fmt::format("is '{}'; use 'reprojection' or 'triangulation'", method));
     }
   }

@@ -56,3 +56,39 @@ TEST(JsonReader, BooleanAcceptsOnlyTrueOrFalse) {
   EXPECT_FALSE(missing.boolean("gone"));
   EXPECT_EQ(missing.error(), "there: key 'gone' is missing");
 }
+
+TEST(JsonReader, ArrayAndObjectReturnTheContainerOrRejectTheKeyWithWhatWasExpected) {
+  const nlohmann::json object = {{"list", {1, 2}}, {"map", {{"a", 1}}}, {"n", 3}};
+  fct::JsonReader reader(object, "here");
+  ASSERT_NE(reader.array("list", "an array of numbers"), nullptr);
+  EXPECT_EQ(reader.array("list", "an array of numbers")->size(), 2u);
+  ASSERT_NE(reader.object("map", "an object of numbers"), nullptr);
+  EXPECT_TRUE(reader.ok());
+  EXPECT_EQ(reader.array("map", "an array of numbers"), nullptr);
+  EXPECT_EQ(reader.error(), "here: key 'map' must be an array of numbers, got an object");
+  fct::JsonReader second(object, "here");
+  EXPECT_EQ(second.object("n", "an object {<view>: fraction}"), nullptr);
+  EXPECT_EQ(second.error(), "here: key 'n' must be an object {<view>: fraction}, got 3");
+  fct::JsonReader third(object, "here");
+  EXPECT_EQ(third.array("missing", "an array"), nullptr);
+  EXPECT_EQ(third.error(), "here: key 'missing' is missing");
+}
+
+TEST(JsonReader, FormatVersionAcceptsOneToNewestAndNamesTheKindOrTheUpdate) {
+  const nlohmann::json current = {{"format", "fluoroct-x"}, {"version", 2}};
+  fct::JsonReader ok(current, "f.json");
+  EXPECT_EQ(ok.formatVersion("fluoroct-x", "x file", 2), 2);
+  EXPECT_TRUE(ok.ok());
+  const nlohmann::json foreign = {{"format", "other"}, {"version", 1}};
+  fct::JsonReader other(foreign, "f.json");
+  EXPECT_EQ(other.formatVersion("fluoroct-x", "x file", 2), 0);
+  EXPECT_EQ(other.error(), "f.json: key 'format' is 'other', not 'fluoroct-x': this is not a FluoroCT x file");
+  const nlohmann::json future = {{"format", "fluoroct-x"}, {"version", 3}};
+  fct::JsonReader newer(future, "f.json");
+  EXPECT_EQ(newer.formatVersion("fluoroct-x", "x file", 2), 0);
+  EXPECT_EQ(newer.error(), "f.json: key 'version' is 3; this program reads versions 1 to 2 (update FluoroCT)");
+  const nlohmann::json versionZero = {{"format", "fluoroct-x"}, {"version", 0}};
+  fct::JsonReader zero(versionZero, "f.json");
+  EXPECT_EQ(zero.formatVersion("fluoroct-x", "x file", 2), 0);
+  EXPECT_FALSE(zero.ok());
+}
