@@ -280,12 +280,8 @@ Status readRegistrationSection(const nlohmann::json& section, const SessionFile&
 Status readResultSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
   const std::string where = file.where + ": result";
   JsonReader reader(section, where);
-  const std::string verdictText = reader.string("verdict");
-  if (const auto verdict = valueNamed(verdictText, kVerdicts)) {
-    content.verdict = *verdict;
-  } else if (reader.ok()) {
-    reader.rejectKey("verdict", fmt::format("is '{}'; use accepted, rejected or undecided", verdictText));
-  }
+  content.verdict =
+      readNamed(reader, "verdict", kVerdicts, "accepted, rejected or undecided").value_or(ResultVerdict::Undecided);
   if (!reader.ok()) return fail(reader.error());
   auto result = RegistrationResultJson::read(section, where);
   if (!result) return fail(result.error());

@@ -1,6 +1,6 @@
 #pragma once
-// NameTable: the names an enumeration is written with in files and messages ("ncc", "genetic", "ok", ...), and the
-// lookups both ways. One table per enumeration, next to where it is read and written:
+// NameTable: the names an enumeration is written with in files and messages ("ncc", "genetic", "ok", ...), the
+// lookups both ways, and reading one from a JSON key. One table per enumeration, next to where it is read and written:
 //   constexpr NameTable<SimilarityMetric, 3> kMetrics{{{"ncc", SimilarityMetric::Ncc}, ...}};
 
 #include <fmt/format.h>
@@ -13,6 +13,8 @@
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "Base/JsonReader.h"
 
 namespace fct {
 
@@ -44,6 +46,18 @@ std::string namesOf(const NameTable<Enum, N>& names) {
   std::vector<std::string_view> accepted;
   for (const auto& entry : names) accepted.push_back(entry.first);
   return fmt::format("{}", fmt::join(accepted, ", "));
+}
+
+/// The value named by the string at `key`; nullopt when the key is bad or names no entry, which the reader then
+/// records as "key '<key>' is '<text>'; use <accepted>" (`accepted` lists the names for a person, e.g. "'a' or 'b'").
+template <typename Enum, std::size_t N>
+std::optional<Enum> readNamed(JsonReader& reader, std::string_view key, const NameTable<Enum, N>& names,
+                              std::string_view accepted) {
+  const std::string text = reader.string(key);
+  if (!reader.ok()) return std::nullopt;
+  if (const std::optional<Enum> value = valueNamed(text, names)) return value;
+  reader.rejectKey(key, fmt::format("is '{}'; use {}", text, accepted));
+  return std::nullopt;
 }
 
 }  // namespace fct

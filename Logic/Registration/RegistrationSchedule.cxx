@@ -17,11 +17,7 @@ namespace {
 /// The value named by `key`; rejects the key (naming the accepted names) for any other text.
 template <typename Enum, std::size_t N>
 Enum parseName(JsonReader& reader, std::string_view key, const NameTable<Enum, N>& names) {
-  const std::string text = reader.string(key);
-  if (!reader.ok()) return names[0].second;
-  if (const std::optional<Enum> value = valueNamed(text, names)) return *value;
-  reader.rejectKey(key, fmt::format("is '{}'; use one of {}", text, namesOf(names)));
-  return names[0].second;
+  return readNamed(reader, key, names, "one of " + namesOf(names)).value_or(names[0].second);
 }
 
 constexpr NameTable<SimilarityMetric, 3> kMetrics{

@@ -32,12 +32,7 @@ Result<LandmarkPairSet> LandmarkPairFile::read(const fs::path& path) {
   set.ctFile = (folder / reader.string("ct")).lexically_normal();
   set.imageFile = (folder / reader.string("image")).lexically_normal();
   if (reader.ok() && reader.has("method")) {
-    const std::string method = reader.string("method");
-    if (const auto known = valueNamed(method, kMethods)) {
-      set.method = *known;
-    } else if (reader.ok()) {
-      reader.rejectKey("method", fmt::format("is '{}'; use 'reprojection' or 'triangulation'", method));
-    }
+    set.method = readNamed(reader, "method", kMethods, "'reprojection' or 'triangulation'").value_or(set.method);
   }
   if (!reader.ok()) return fail(reader.error());
   std::vector<std::string> warnings = reader.unknownKeys({"ct", "image", "method"});

@@ -24,3 +24,15 @@ TEST(NameTable, UnknownNamesAndValuesAreNotGuessed) {
   EXPECT_FALSE(fct::valueNamed("", kColours).has_value());
   EXPECT_EQ(fct::nameOf(Colour::Blue, kColours), "unknown");
 }
+
+TEST(NameTable, ReadNamedReadsTheValueOrRejectsTheKeyListingTheNames) {
+  const nlohmann::json object = {{"good", "green"}, {"bad", "pink"}, {"number", 3}};
+  fct::JsonReader reader(object, "f.json");
+  EXPECT_EQ(fct::readNamed(reader, "good", kColours, "red or green"), Colour::Green);
+  EXPECT_TRUE(reader.ok());
+  EXPECT_FALSE(fct::readNamed(reader, "bad", kColours, "red or green").has_value());
+  EXPECT_EQ(reader.error(), "f.json: key 'bad' is 'pink'; use red or green");
+  fct::JsonReader second(object, "f.json");
+  EXPECT_FALSE(fct::readNamed(second, "number", kColours, "red or green").has_value());
+  EXPECT_NE(second.error().find("key 'number' must be a string"), std::string::npos) << second.error();
+}
