@@ -199,6 +199,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   report.drrs = objective.drrCount();
   report.fallbackRays = objective.fallbackRayCount();
   report.seconds = secondsSince(stageStart);
+  report.T_world_from_ct = registrationCase.poseTransform(current);
   return report;
 }
 
@@ -207,7 +208,8 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
 Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
                                              const RegistrationOptions& options,
                                              const RegistrationProgressCallback& onProgress,
-                                             const std::atomic<bool>* cancel) {
+                                             const std::atomic<bool>* cancel,
+                                             const RegistrationStageCallback& onStageEnd) {
   const auto runStart = Clock::now();
   RegistrationResult result;
   result.schedule = options.schedule.withAblation(options.ablation).withSeed(options.seed);
@@ -241,6 +243,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
     if (!report) return fail(report.error());
     result.totalDrrs += report.value().drrs;
     result.stages.push_back(std::move(report).value());
+    if (onStageEnd) onStageEnd(result.stages.back());
     if (result.stages.back().cancelled) {
       result.cancelled = true;
       break;

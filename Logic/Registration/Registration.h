@@ -58,7 +58,10 @@ struct StageReport {
   double similarity = 0.0;         ///< at the stage's final pose (>= startSimilarity)
   std::vector<double> keptFraction;  ///< per view: compared pixels / valid pixels at the stage's level
   bool cancelled = false;
+  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the stage's final pose (LPS mm)
 };
+/// Receives each stage's report as the stage ends (called on the registration's thread).
+using RegistrationStageCallback = std::function<void(const StageReport&)>;
 
 /// The outcome of a run.
 struct RegistrationResult {
@@ -83,10 +86,12 @@ class Registration {
   /// Registers from `T_initial` (CT mm -> world mm). Fails, with a message naming the stage or view, on an empty
   /// schedule, a non-rigid initial pose, DRR and X-ray not overlapping at the initial pose, a stage whose pixel set
   /// or metric cannot be built, or a rendering error. A cancelled run is a success with `cancelled` set.
+  /// `onStageEnd` gets each stage's report (with its final pose) as the stage ends.
   static Result<RegistrationResult> run(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
                                         const RegistrationOptions& options,
                                         const RegistrationProgressCallback& onProgress = {},
-                                        const std::atomic<bool>* cancel = nullptr);
+                                        const std::atomic<bool>* cancel = nullptr,
+                                        const RegistrationStageCallback& onStageEnd = {});
 };
 
 }  // namespace fct
