@@ -12,6 +12,9 @@ namespace fct::cli {
 
 /// Exit status of every failed command.
 constexpr int kExitError = 2;
+/// Exit status of `register --igtl` when the registration succeeded and its result was written, but the pose could
+/// not be sent over OpenIGTLink.
+constexpr int kExitSendFailed = 3;
 
 /// The action a parsed subcommand runs; returns the process exit status.
 using CommandAction = std::function<int()>;

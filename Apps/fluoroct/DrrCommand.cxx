@@ -1,4 +1,5 @@
-// fluoroct drr: renders a DRR of a CT for every view of a view file (or one) and writes one image per view.
+// fluoroct drr: renders a DRR of a CT for every view of a view file (or one) and writes one image per view; with
+// --image, the one view's DRR to exactly that file (the form the 3D Slicer CLI module uses; SlicerModule.h).
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -13,10 +14,10 @@
 #include "CliSupport.h"
 #include "Drr/DrrRendererFactory.h"
 #include "Drr/DrrVolume.h"
-#include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
+#include "SlicerModule.h"
 
 namespace fct::cli {
 
@@ -26,6 +27,8 @@ namespace fs = std::filesystem;
 
 struct DrrCommandOptions {
   std::string ct, views, pose, view, out;
+  std::string image;                ///< exact output file of the one selected view's DRR (instead of --out)
+  std::string returnParameterFile;  ///< optional "name = value" file of the scalar results (Slicer CLI modules)
   std::string method = "siddon";
   std::string values = "attenuation";
   int level = 0;
@@ -53,12 +56,23 @@ Status writeDrr(const FloatImage& image, const fs::path& path, const std::string
   return ImageFileWriter::writePng16(image, path, *lo, *hi > *lo ? *hi : *lo + 1.0f);
 }
 
-int runDrr(const DrrCommandOptions& options) {
+/// The output file of view `name`: --image itself, or PREFIX_<view>.<ext> of --out.
+fs::path outputPath(const DrrCommandOptions& options, const std::string& name) {
+  if (!options.image.empty()) return options.image;
   const fs::path out(options.out);
+  return fs::path((out.parent_path() / out.stem()).string() + "_" + fileSafe(name) + out.extension().string());
+}
+
+int runDrr(const DrrCommandOptions& options) {
+  if (options.out.empty() == options.image.empty()) {
+    return reportError("give exactly one of --out PREFIX.ext (one file per view) or --image FILE (one view's DRR)");
+  }
+  const std::string flag = options.image.empty() ? "--out" : "--image";
+  const fs::path out(options.image.empty() ? options.out : options.image);
   const std::string extension = out.extension().string();
   if (extension != ".nrrd" && extension != ".pfm" && extension != ".tif" && extension != ".tiff" &&
       extension != ".png") {
-    return reportError(fmt::format("--out '{}' must end in .nrrd, .pfm, .tif or .png", options.out));
+    return reportError(fmt::format("{} '{}' must end in .nrrd, .pfm, .tif or .png", flag, out.string()));
   }
   if (!out.parent_path().empty() && !fs::is_directory(out.parent_path())) {
     return reportError(fmt::format("output folder '{}' does not exist; create it first", out.parent_path().string()));
@@ -81,10 +95,16 @@ int runDrr(const DrrCommandOptions& options) {
       return reportError(fmt::format("view '{}' is not in {}; its views are: {}", options.view, options.views, names));
     }
   }
+  if (!options.image.empty() && selected.size() > 1) {
+    std::string names;
+    for (const auto& v : selected) names += (names.empty() ? "" : ", ") + v.name;
+    return reportError(fmt::format("--image writes one DRR, but {} has {} views ({}); choose one with --view",
+                                   options.views, selected.size(), names));
+  }
   Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();
   if (!options.pose.empty()) {
-    const auto pose = PoseFile::read(options.pose);
-    if (!pose.ok()) return reportError(pose.error());
+    const auto pose = readPoseOrTransform(options.pose);
+    if (!pose.ok()) return reportError("--pose: " + pose.error());
     T_world_from_ct = pose.value();
   }
 
@@ -119,15 +139,21 @@ int runDrr(const DrrCommandOptions& options) {
     if (!rendered.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, rendered.error()));
     seconds[n] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  const fs::path prefix = out.parent_path() / out.stem();
   for (std::size_t n = 0; n < selected.size(); ++n) {
-    const fs::path path = fs::path(prefix.string() + "_" + fileSafe(selected[n].name) + extension);
+    const fs::path path = outputPath(options, selected[n].name);
     const Eigen::Vector2d spacing_mm = selected[n].camera.downsampled(options.level).intrinsics().pixelSpacing_mm;
     const Status written = writeDrr(images[n], path, extension, spacing_mm);
     if (!written.ok()) return reportError(written.error());
     const auto [lo, hi] = std::minmax_element(images[n].pixels.begin(), images[n].pixels.end());
     fmt::print("wrote {}: {} x {} px, {} {} DRR, level {}, values {:.4g}..{:.4g}, {:.3f} s\n", path.string(),
                images[n].cols, images[n].rows, options.method, options.values, options.level, *lo, *hi, seconds[n]);
+  }
+  if (!options.returnParameterFile.empty()) {
+    double total_s = 0.0;
+    for (const double s : seconds) total_s += s;
+    const Status written =
+        writeReturnParameters(options.returnParameterFile, {{"renderSeconds", fmt::format("{:.4f}", total_s)}});
+    if (!written.ok()) return reportError(written.error());
   }
   return 0;
 }
@@ -142,7 +168,9 @@ void registerDrrCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--ct", options->ct, "CT volume file (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd) or DICOM folder")
       ->required();
   command->add_option("--views", options->views, "View file (JSON) with the calibrated cameras")->required();
-  command->add_option("--pose", options->pose, "Pose file with T_world_from_ct (default: identity)");
+  command->add_option("--pose", options->pose,
+                      "Pose file with T_world_from_ct, or ITK transform (.tfm, as 3D Slicer saves it) (default: "
+                      "identity)");
   command->add_option("--view", options->view, "Render only the view with this name");
   command->add_option("--method", options->method, "siddon (exact voxel traversal), raycast (trilinear sampling) or transgraph (precomputed ray table per view, cached on disk; see README)")
       ->capture_default_str();
@@ -158,8 +186,13 @@ void registerDrrCommand(CLI::App& app, CommandAction& action) {
                       "Transgraph plane sampling step in mm (smaller: more accurate, rays grow as step^-4)")
       ->check(positiveNumber())
       ->capture_default_str();
-  command->add_option("--out", options->out, "Output prefix and format, e.g. out/drr.nrrd -> out/drr_<view>.nrrd")
-      ->required();
+  command->add_option("--out", options->out, "Output prefix and format, e.g. out/drr.nrrd -> out/drr_<view>.nrrd");
+  command->add_option("--image", options->image,
+                      "Instead of --out: write the DRR of the one view (--view, or the view file's only view) to "
+                      "exactly this file");
+  command->add_option("--returnparameterfile", options->returnParameterFile,
+                      "Write the scalar results (renderSeconds) as 'name = value' lines, as 3D Slicer's CLI modules do");
+  addModuleXmlFlag(command, drrModuleXml());
   command->callback([&action, options] { action = [options] { return runDrr(*options); }; });
 }
 

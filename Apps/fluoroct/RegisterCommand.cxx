@@ -1,5 +1,7 @@
 // fluoroct register: registers a CT to the X-ray views of a view file (Registration, a preset schedule) from an
-// initial pose given as a pose file or estimated from landmarks; writes RESULT.json.
+// initial pose given as a pose file or estimated from landmarks; writes RESULT.json. Also a 3D Slicer CLI module
+// (--xml, --tfm, --returnparameterfile; SlicerModule.h) and, with --igtl, sends the pose live to Slicer over
+// OpenIGTLink (Interop/IgtlTransformSender) once the result is written.
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -16,6 +18,8 @@
 #include "CliSupport.h"
 #include "Evaluation/ContourOverlay.h"
 #include "InitialPose/LandmarkPoseEstimator.h"
+#include "Interop/IgtlTransformSender.h"
+#include "IO/Project/ItkTransformFile.h"
 #include "IO/Project/LandmarkPairFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
@@ -23,6 +27,7 @@
 #include "Registration/Registration.h"
 #include "Registration/RegistrationResultJson.h"
 #include "Registration/RegistrationViewLoader.h"
+#include "SlicerModule.h"
 
 namespace fct::cli {
 
@@ -49,6 +54,11 @@ struct Options {
   double metalMinExcess = MetalMaskOptions{}.minExcess;
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
   RegistrationAblation ablation;
+  std::string tfm;                  ///< optional ITK transform file of the registered pose (Slicer's output transform)
+  std::string returnParameterFile;  ///< optional "name = value" file of the scalar results (Slicer CLI modules)
+  std::string igtl;                 ///< optional OpenIGTLink server HOST:PORT to send the pose to
+  std::string igtlDevice = "FluoroCT";
+  bool igtlProgress = false;
 };
 
 /// Writes a validity mask as an 8-bit-range PNG (white = compared, black = excluded), creating the folder.
@@ -113,7 +123,7 @@ Result<InitialPose> poseFromLandmarks(const std::string& path, const std::vector
 /// The initial pose from --init or --landmarks.
 Result<InitialPose> initialPose(const Options& o, const std::vector<RegistrationView>& views) {
   if (o.init.empty()) return poseFromLandmarks(o.landmarks, views);
-  auto pose = PoseFile::read(o.init);
+  auto pose = readPoseOrTransform(o.init);
   if (!pose) return fail("--init: " + pose.error());
   return InitialPose{pose.value(), nlohmann::ordered_json{{"source", "pose file"}, {"path", o.init}}};
 }
@@ -131,7 +141,10 @@ struct Inputs {
 /// Checks the options and reads the views, the initial pose, the truth and the CT; warnings go to stderr.
 Result<Inputs> readInputs(const Options& o) {
   if (o.init.empty() == o.landmarks.empty()) {
-    return fail("give the initial pose with exactly one of --init POSE.json or --landmarks LM.json");
+    return fail("give the initial pose with exactly one of --init POSE.json|POSE.tfm or --landmarks LM.json");
+  }
+  if (!o.tfm.empty()) {
+    if (Status writable = checkWritableTransform(o.tfm); !writable) return fail("--tfm: " + writable.error());
   }
   Inputs in;
   auto method = DrrRendererFactory::parseMethod(o.method);
@@ -259,9 +272,11 @@ Status writeMasks(const Options& o, const RegistrationCase& c) {
   return Ok{};
 }
 
-/// Runs the schedule from the initial pose, with the progress bar on stderr under --progress.
+/// Runs the schedule from the initial pose, with the progress bar on stderr under --progress; `onStageEnd` gets each
+/// stage's report.
 Result<RegistrationResult> runRegistration(const Options& o, const Inputs& in, RegistrationCase& registrationCase,
-                                           const std::atomic<bool>* cancel) {
+                                           const std::atomic<bool>* cancel,
+                                           const RegistrationStageCallback& onStageEnd) {
   RegistrationOptions options;
   options.schedule = in.schedule;
   options.ablation = o.ablation;
@@ -269,7 +284,8 @@ Result<RegistrationResult> runRegistration(const Options& o, const Inputs& in, R
   ProgressBar bar;
   RegistrationProgressCallback onProgress;
   if (o.progress) onProgress = [&bar](const RegistrationProgress& p) { bar.update(p); };
-  auto result = Registration::run(registrationCase, in.initial.T_world_from_ct, options, onProgress, cancel);
+  auto result =
+      Registration::run(registrationCase, in.initial.T_world_from_ct, options, onProgress, cancel, onStageEnd);
   bar.finish();
   return result;
 }
@@ -351,7 +367,83 @@ void printResult(const Options& o, const RegistrationResult& r, const std::optio
   }
 }
 
+/// --igtl: the live link to an OpenIGTLink server (3D Slicer); does nothing without --igtl. Failures before the
+/// final pose are warnings: the registration and its result files never depend on the link.
+class SlicerLink {
+ public:
+  /// Checks --igtl and --igtl-device; fails naming the flag.
+  static Result<SlicerLink> fromOptions(const Options& o) {
+    SlicerLink link;
+    if (o.igtl.empty()) return link;
+    auto endpoint = IgtlTransformSender::parseEndpoint(o.igtl);
+    if (!endpoint) return fail("--igtl: " + endpoint.error());
+    if (Status name = IgtlTransformSender::checkDeviceName(o.igtlDevice); !name) {
+      return fail("--igtl-device: " + name.error());
+    }
+    link.m_sender = std::make_shared<IgtlTransformSender>(endpoint.value(), o.igtlDevice);
+    return link;
+  }
+
+  /// Connects now, so that a missing server is reported before the registration starts (a warning).
+  void connectEarly() {
+    if (!m_sender) return;
+    if (Status connected = m_sender->connect(); !connected) {
+      printWarnings({"--igtl: " + connected.error() + "; registering anyway, the pose is sent when it is ready"});
+    }
+  }
+
+  /// --igtl-progress: sends a stage's final pose; a failure is a warning.
+  void sendStage(const StageReport& stage) {
+    if (!m_sender) return;
+    if (Status sent = m_sender->send(stage.T_world_from_ct); !sent) {
+      printWarnings({fmt::format("--igtl-progress: the pose after stage '{}' was not sent: {}", stage.name,
+                                 sent.error())});
+    }
+  }
+
+  /// Sends the registered pose; returns 0, or kExitSendFailed with an error naming --igtl and the kept result.
+  int sendFinal(const Eigen::Isometry3d& T_world_from_ct, const Options& o) {
+    if (!m_sender) return 0;
+    if (Status sent = m_sender->send(T_world_from_ct); !sent) {
+      std::vector<std::string> kept;
+      for (const std::string& file : {o.out, o.tfm}) {
+        if (!file.empty()) kept.push_back(file);
+      }
+      reportError(fmt::format("--igtl: the registered pose was not sent: {}; {}", sent.error(),
+                              kept.empty() ? std::string("the result is printed above")
+                                           : fmt::format("the result is kept in {}", fmt::join(kept, " and "))));
+      return kExitSendFailed;
+    }
+    fmt::print("sent the pose to the OpenIGTLink server at {} as TRANSFORM '{}' (RAS)\n", m_sender->endpoint().text(),
+               o.igtlDevice);
+    return 0;
+  }
+
+ private:
+  std::shared_ptr<IgtlTransformSender> m_sender;
+};
+
+/// Writes the result files: RESULT.json (--out), the ITK transform (--tfm) and the scalar results
+/// (--returnparameterfile).
+Status writeResults(const Options& o, const RegistrationResult& r, const nlohmann::ordered_json& json) {
+  if (!o.out.empty()) {
+    if (Status written = JsonDocument::write(json, o.out); !written) return written;
+  }
+  if (!o.tfm.empty()) {
+    if (Status written = ItkTransformFile::write(r.T_world_from_ct, o.tfm); !written) return fail("--tfm: " + written.error());
+  }
+  if (!o.returnParameterFile.empty()) {
+    const double finalSimilarity = r.stages.empty() ? 0.0 : r.stages.back().similarity;
+    return writeReturnParameters(o.returnParameterFile, {{"finalSimilarity", fmt::format("{:.6f}", finalSimilarity)},
+                                                         {"registrationSeconds", fmt::format("{:.3f}", r.totalSeconds)},
+                                                         {"drrCount", std::to_string(r.totalDrrs)}});
+  }
+  return Ok{};
+}
+
 int runRegister(const Options& o) {
+  auto link = SlicerLink::fromOptions(o);
+  if (!link) return reportError(link.error());
   auto inputs = readInputs(o);
   if (!inputs) return reportError(inputs.error());
   const Inputs& in = inputs.value();
@@ -363,20 +455,21 @@ int runRegister(const Options& o) {
   nlohmann::ordered_json metal = metalReport(o, registrationCase.value());
   if (Status written = writeMasks(o, registrationCase.value()); !written) return reportError(written.error());
 
-  auto result = runRegistration(o, in, registrationCase.value(), InterruptGuard::cancelFlag());
+  link.value().connectEarly();
+  RegistrationStageCallback onStageEnd;
+  if (o.igtlProgress) onStageEnd = [&link](const StageReport& stage) { link.value().sendStage(stage); };
+  auto result = runRegistration(o, in, registrationCase.value(), InterruptGuard::cancelFlag(), onStageEnd);
   if (!result) return reportError(result.error());
   const RegistrationResult& r = result.value();
   if (Status written = writeOverlays(o, in, caseOptions.boneThreshold_hu, r); !written) {
     return reportError(written.error());
   }
   const std::optional<TruthError> error = truthError(in, registrationCase.value(), r);
-  if (!o.out.empty()) {
-    const Status written =
-        JsonDocument::write(resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal), error), o.out);
-    if (!written) return reportError(written.error());
-  }
+  const Status written =
+      writeResults(o, r, resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal), error));
+  if (!written) return reportError(written.error());
   printResult(o, r, error);
-  return 0;
+  return link.value().sendFinal(r.T_world_from_ct, o);
 }
 
 }  // namespace
@@ -390,7 +483,8 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       ->required();
   command->add_option("--views", options->views, "View file (JSON) with each view's image, detector and camera")
       ->required();
-  auto* init = command->add_option("--init", options->init, "Initial pose file {\"T_world_from_ct\": 4x4}");
+  auto* init = command->add_option(
+      "--init", options->init, "Initial pose file {\"T_world_from_ct\": 4x4} or ITK transform (.tfm, as 3D Slicer saves it)");
   auto* landmarks = command->add_option(
       "--landmarks", options->landmarks,
       "Landmark pair file {\"ct\": \"points.mrk.json\", \"image\": \"clicks.json\", \"method\": "
@@ -411,6 +505,21 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       ->check(positiveNumber())
       ->capture_default_str();
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
+  command->add_option("--tfm", options->tfm,
+                      "Also write the registered pose as an ITK transform (.tfm) that 3D Slicer opens (the "
+                      "transform to put the CT under)");
+  command->add_option("--returnparameterfile", options->returnParameterFile,
+                      "Write the scalar results (finalSimilarity, registrationSeconds, drrCount) as 'name = value' "
+                      "lines, as 3D Slicer's CLI modules do");
+  auto* igtl = command->add_option("--igtl", options->igtl,
+                      "Send the registered pose to an OpenIGTLink server HOST:PORT (3D Slicer's OpenIGTLinkIF, port "
+                      "18944) as a TRANSFORM in RAS, after the result files are written; connect and send time out "
+                      "after 3 s; exit status 3 if it was not sent");
+  command->add_option("--igtl-device", options->igtlDevice, "Device name of the TRANSFORM (1-20 characters)")
+      ->capture_default_str()
+      ->needs(igtl);
+  command->add_flag("--igtl-progress", options->igtlProgress, "With --igtl: also send the pose after each stage")
+      ->needs(igtl);
   command->add_option("--truth", options->truth,
                       "Known true pose file (simulated cases): report the mean/max bone-surface distance to it");
   command->add_option("--overlays", options->overlays,
@@ -438,6 +547,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_flag("--no-ct-pyramid", options->ablation.noCtPyramid,
                     "Exact DRRs of coarse pyramid levels integrate the full CT instead of one box-averaged to the "
                     "level's pixel size at the bone");
+  addModuleXmlFlag(command, registerModuleXml());
   command->callback([&action, options] { action = [options] { return runRegister(*options); }; });
 }
 

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::Success&) {
+    return 0;  // e.g. --xml printed the Slicer module description
   } catch (const CLI::ParseError& e) {
     return reportError(fmt::format("{} (run 'fluoroct --help' or 'fluoroct COMMAND --help')", e.what()));
   }

@@ -4,6 +4,10 @@
 #include <igtlServerSocket.h>
 #include <igtlTransformMessage.h>
 
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <cstring>
 #include <iostream>
 
@@ -67,7 +71,21 @@ IgtlTestReceiver::~IgtlTestReceiver() {
 
 std::string IgtlTestReceiver::endpoint() const { return "127.0.0.1:" + std::to_string(m_port); }
 
-std::vector<ReceivedTransform> IgtlTestReceiver::received() { return m_done.valid() ? m_done.get() : std::vector<ReceivedTransform>{}; }
+std::vector<ReceivedTransform> IgtlTestReceiver::received() {
+  return m_done.valid() ? m_done.get() : std::vector<ReceivedTransform>{};
+}
+
+int IgtlTestReceiver::unusedPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  const bool bound = ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
+                     ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0;
+  ::close(fd);
+  return bound ? ntohs(address.sin_port) : 0;
+}
 
 void IgtlTestReceiver::print(const std::vector<ReceivedTransform>& transforms) {
   const Eigen::IOFormat format(6, 0, " ", "\n", "    [", "]");

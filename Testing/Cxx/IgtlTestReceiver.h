@@ -41,6 +41,8 @@ class IgtlTestReceiver {
   /// Waits until the server is done (its client closed, the messages arrived, or it closed the connection) and
   /// returns the TRANSFORMs received; may be called once.
   std::vector<ReceivedTransform> received();
+  /// A loopback port nothing listens on (bound, then closed again), for the refused-connection tests.
+  static int unusedPort();
   /// Prints each received transform (device name and matrix) on stdout, as the report of a loopback run.
   static void print(const std::vector<ReceivedTransform>& transforms);
 

@@ -12,43 +12,15 @@
 #include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationResultJson.h"
+#include "SimulatedCliCase.h"
 #include "TestSupport.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-/// A small simulated phantom case in `dir`: ct.nrrd, views.json (3 views, 160x160 at 2 mm), sim/ (images, view file,
-/// truth pose). Returns the truth pose.
-Eigen::Isometry3d makeCase(const fs::path& dir) {
-  auto run = fct::test::runCli(fmt::format("phantom --out '{}' --dims 80 80 60 --spacing-mm 2", (dir / "ct.nrrd").string()));
-  EXPECT_EQ(run.exitCode, 0) << run.err;
-  run = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --detector 160x160 --pixel-mm 2 --sid-mm 1000 "
-                                      "--sad-mm 700",
-                                      (dir / "ct.nrrd").string(), (dir / "views.json").string()));
-  EXPECT_EQ(run.exitCode, 0) << run.err;
-  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
-  truth.linear() = Eigen::AngleAxisd(0.05, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  truth.translation() = Eigen::Vector3d(2.0, -1.0, 3.0);
-  EXPECT_TRUE(fct::PoseFile::write(truth, dir / "truth.json").ok());
-  run = fct::test::runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --noise-photons 3000",
-                                      (dir / "ct.nrrd").string(), (dir / "views.json").string(),
-                                      (dir / "truth.json").string(), (dir / "sim").string()));
-  EXPECT_EQ(run.exitCode, 0) << run.err;
-  return truth;
-}
-
-Eigen::Isometry3d perturbed(const Eigen::Isometry3d& truth) {
-  Eigen::Isometry3d start = truth;
-  start.translation() += Eigen::Vector3d(2.0, -1.5, 1.0);
-  start.linear() = Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitZ()).toRotationMatrix() * start.linear();
-  return start;
-}
-
-bool oneErrorLine(const fct::test::ProcessResult& run) {
-  return run.exitCode == 2 && run.err.rfind("error: ", 0) == 0 &&
-         std::count(run.err.begin(), run.err.end(), '\n') == 1;
-}
+using fct::test::makeCase;
+using fct::test::oneErrorLine;
+using fct::test::perturbed;
 
 }  // namespace
 

@@ -24,19 +24,6 @@ Eigen::Isometry3d nonSymmetricPose() {
   return T;
 }
 
-/// A loopback port nothing listens on: bound, then closed again.
-int closedPort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof address;
-  ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-  ::close(fd);
-  return ntohs(address.sin_port);
-}
-
 TEST(IgtlTransformSender, RasFromLpsFlipsTheFirstTwoAxesOnBothSides) {
   const Eigen::Isometry3d T = nonSymmetricPose();
   const Eigen::Matrix4d ras = IgtlTransformSender::rasFromLps(T);
@@ -73,7 +60,7 @@ TEST(IgtlTransformSender, LoopbackServerReceivesTheDeviceNameAndTheRasMatrix) {
 }
 
 TEST(IgtlTransformSender, RefusedConnectionSaysNothingListensAndHowToStartSlicersServer) {
-  const int port = closedPort();
+  const int port = IgtlTestReceiver::unusedPort();
   IgtlTransformSender sender({"127.0.0.1", port}, "FluoroCT");
   const Status sent = sender.send(nonSymmetricPose());
   ASSERT_FALSE(sent.ok());
@@ -139,7 +126,7 @@ TEST(IgtlTransformSender, RefusesDeviceNamesTheHeaderCannotHoldBeforeConnecting)
   EXPECT_FALSE(IgtlTransformSender::checkDeviceName("").ok());
   EXPECT_FALSE(IgtlTransformSender::checkDeviceName("A-device-name-too-long").ok());
   EXPECT_FALSE(IgtlTransformSender::checkDeviceName("tab\there").ok());
-  IgtlTransformSender sender({"127.0.0.1", closedPort()}, "");
+  IgtlTransformSender sender({"127.0.0.1", IgtlTestReceiver::unusedPort()}, "");
   const Status sent = sender.send(Eigen::Isometry3d::Identity());
   ASSERT_FALSE(sent.ok());
   EXPECT_NE(sent.error().find("device name"), std::string::npos) << sent.error();
