@@ -6,20 +6,25 @@
 #include <QComboBox>
 #include <QFileDialog>
 #include <QFormLayout>
+#include <QFutureWatcher>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QLabel>
+#include <QLineEdit>
 #include <QPainter>
 #include <QPixmap>
 #include <QPushButton>
 #include <QSignalBlocker>
 #include <QSlider>
+#include <QSpinBox>
 #include <QTimer>
 #include <QVBoxLayout>
+#include <QtConcurrent/QtConcurrentRun>
 
 #include <algorithm>
 
 #include "IO/Project/ItkTransformFile.h"
+#include "Interop/IgtlTransformSender.h"
 #include "IO/Project/PoseFile.h"
 #include "Widgets/StudioDocument.h"
 #include "Widgets/XrayViewWidget.h"
@@ -128,6 +133,22 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
   exportRow->addWidget(exportButton);
   exportRow->addWidget(screenshotButton);
   layout->addLayout(exportRow);
+
+  auto* slicerBox = new QGroupBox(tr("3D Slicer (OpenIGTLink)"), this);
+  auto* slicerRow = new QHBoxLayout(slicerBox);
+  m_slicerHost = new QLineEdit(QStringLiteral("localhost"), slicerBox);
+  m_slicerHost->setToolTip(tr("Host of 3D Slicer's OpenIGTLinkIF server connector"));
+  m_slicerPort = new QSpinBox(slicerBox);
+  m_slicerPort->setRange(1, 65535);
+  m_slicerPort->setValue(18944);
+  m_sendToSlicerButton = new QPushButton(tr("Send to Slicer"), slicerBox);
+  m_sendToSlicerButton->setObjectName(QStringLiteral("sendToSlicerButton"));
+  m_sendToSlicerButton->setToolTip(tr("Send the final pose as the OpenIGTLink TRANSFORM 'FluoroCT' (RAS)"));
+  slicerRow->addWidget(m_slicerHost, 1);
+  slicerRow->addWidget(m_slicerPort);
+  slicerRow->addWidget(m_sendToSlicerButton);
+  layout->addWidget(slicerBox);
+  m_slicerSend = new QFutureWatcher<QString>(this);
   m_message = new QLabel(this);
   m_message->setWordWrap(true);
   m_message->setTextInteractionFlags(Qt::TextSelectableByMouse);
@@ -162,6 +183,18 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
     const QString path = QFileDialog::getSaveFileName(this, tr("Export pose"), QStringLiteral("pose.tfm"),
                                                       tr("3D Slicer transform (*.tfm);;Pose JSON (*.json)"));
     if (!path.isEmpty()) exportPose(path);
+  });
+  connect(m_sendToSlicerButton, &QPushButton::clicked, this, &ReviewStepWidget::sendToSlicer);
+  connect(m_slicerSend, &QFutureWatcher<QString>::finished, this, [this] {
+    m_sendToSlicerButton->setEnabled(true);
+    const QString error = m_slicerSend->result();
+    const QString where = QStringLiteral("%1:%2").arg(m_slicerHost->text().trimmed()).arg(m_slicerPort->value());
+    if (error.isEmpty()) {
+      showMessage(tr("Sent the final pose to 3D Slicer at %1 as the transform 'FluoroCT'.").arg(where), false);
+    } else {
+      showMessage(tr("Not sent to 3D Slicer: %1").arg(error), true);
+    }
+    emit slicerSendFinished(error.isEmpty());
   });
   connect(screenshotButton, &QPushButton::clicked, this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, tr("Save screenshot"), QStringLiteral("review.png"),
@@ -457,6 +490,33 @@ bool ReviewStepWidget::exportPose(const QString& path) {
   showMessage(tr("Exported the final pose%1 to %2.").arg(result->cancelled ? tr(" (cancelled run)") : QString(), path),
               false);
   return true;
+}
+
+void ReviewStepWidget::setSlicerAddress(const QString& host, int port) {
+  m_slicerHost->setText(host);
+  m_slicerPort->setValue(port);
+}
+
+void ReviewStepWidget::sendToSlicer() {
+  if (m_slicerSend->isRunning()) return;
+  const auto& result = m_document->result();
+  const QString host = m_slicerHost->text().trimmed();
+  if (!result || host.isEmpty()) {
+    showMessage(result ? tr("Enter the host of 3D Slicer (e.g. localhost) before sending.")
+                       : tr("No registration result to send: run one in the Register step."),
+                true);
+    emit slicerSendFinished(false);
+    return;
+  }
+  const IgtlEndpoint endpoint{host.toStdString(), m_slicerPort->value()};
+  const Eigen::Isometry3d T_world_from_ct = result->T_world_from_ct;
+  m_sendToSlicerButton->setEnabled(false);
+  showMessage(tr("Sending the final pose to 3D Slicer at %1…").arg(QString::fromStdString(endpoint.text())), false);
+  m_slicerSend->setFuture(QtConcurrent::run([endpoint, T_world_from_ct] {
+    IgtlTransformSender sender(endpoint, "FluoroCT");
+    const Status sent = sender.send(T_world_from_ct);
+    return sent ? QString() : QString::fromStdString(sent.error());
+  }));
 }
 
 bool ReviewStepWidget::saveScreenshot(const QString& path) {

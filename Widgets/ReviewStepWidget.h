@@ -4,7 +4,8 @@
 // with an opacity; the DRR at the final pose blended over the X-ray or as a checkerboard, with a flicker toggle
 // (a QTimer switching the DRR on and off). With a ground truth (simulated case) the sTRE, the mean bone-surface
 // distance to the truth (BoneSurface), is shown for both poses. Accept / Reject record the verdict in the document;
-// the final pose exports as an ITK .tfm for 3D Slicer or as pose JSON, and the X-ray views as a PNG screenshot.
+// the final pose exports as an ITK .tfm for 3D Slicer or as pose JSON, and the X-ray views as a PNG screenshot;
+// "Send to Slicer" sends it live to 3D Slicer's OpenIGTLinkIF (host and port fields) off the GUI thread.
 
 #include <Eigen/Core>
 #include <QColor>
@@ -24,9 +25,13 @@
 class QCheckBox;
 class QComboBox;
 class QLabel;
+class QLineEdit;
 class QPushButton;
 class QSlider;
+class QSpinBox;
 class QTimer;
+template <typename T>
+class QFutureWatcher;
 
 namespace fct {
 
@@ -85,6 +90,15 @@ class ReviewStepWidget : public QWidget {
   bool exportPose(const QString& path);
   /// Saves the X-ray views side by side as a PNG. False with the reason shown.
   bool saveScreenshot(const QString& path);
+  /// Sets the OpenIGTLink server that "Send to Slicer" sends to (3D Slicer's OpenIGTLinkIF; default localhost:18944).
+  void setSlicerAddress(const QString& host, int port);
+  /// Sends the final pose to the OpenIGTLink server as a TRANSFORM "FluoroCT" in RAS, in a worker thread; the outcome
+  /// is shown in the message line and signalled by slicerSendFinished. Refused without a result or a host.
+  void sendToSlicer();
+
+ signals:
+  /// A "Send to Slicer" finished: sent, or not (the reason is in message()).
+  void slicerSendFinished(bool sent);
 
  private:
   /// The (initial, final) poses to review as matrices: the result's, or the document's initial pose alone.
@@ -133,6 +147,10 @@ class ReviewStepWidget : public QWidget {
   QLabel* m_treLabel;
   QLabel* m_verdictLabel;
   QLabel* m_message;
+  QLineEdit* m_slicerHost;
+  QSpinBox* m_slicerPort;
+  QPushButton* m_sendToSlicerButton;
+  QFutureWatcher<QString>* m_slicerSend;  ///< the send in flight; its result is the error text, empty when sent
 };
 
 }  // namespace fct
