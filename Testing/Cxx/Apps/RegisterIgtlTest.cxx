@@ -93,12 +93,13 @@ TEST(RegisterCommand, OpenIgtLinkServerThatClosesEarlyKeepsTheResultAndExitsWith
 }
 
 TEST(RegisterCommand, RefusesABadOpenIgtLinkAddressOrDeviceBeforeRegistering) {
-  const fs::path dir = preparedCase();
+  const fs::path dir = fct::test::scratchDir();  // no case: the link is checked before any input is read
   const auto badAddress = fct::test::runCli(registerCommand(dir) + " --igtl localhost");
   EXPECT_TRUE(fct::test::oneErrorLine(badAddress)) << badAddress.err;
   EXPECT_NE(badAddress.err.find("--igtl: 'localhost' is not HOST:PORT"), std::string::npos) << badAddress.err;
   const auto badDevice = fct::test::runCli(registerCommand(dir) + " --igtl localhost:18944 --igtl-device ''");
   EXPECT_TRUE(fct::test::oneErrorLine(badDevice)) << badDevice.err;
   EXPECT_NE(badDevice.err.find("--igtl-device"), std::string::npos) << badDevice.err;
+  EXPECT_EQ(badDevice.err.find("--ct"), std::string::npos) << "refused before the inputs: " << badDevice.err;
   EXPECT_FALSE(fs::exists(dir / "result.json")) << "nothing registered, nothing written";
 }
