@@ -200,30 +200,28 @@ Result<StudyDefinition> checkOptions(const EvaluateOptions& o) {
 /// Loads the CTs of the checked study `known` and defines it over them. For a run, checks (or writes) DIR/setup.txt
 /// against the trials in `store`; a merge checks its folders later (StudyMerge). Fails with the message to report.
 Result<PreparedStudy> prepareStudy(const EvaluateOptions& o, const StudyDefinition& known, const TrialStore* store) {
-  std::optional<StudyShard> shard;
-  if (!o.shard.empty()) shard = StudyShard::parse(known, o.shard).value();  // checked by checkOptions
   // The CTs are found before setup.txt is written, so that a run without them leaves no setup behind.
   auto cts = loadCts(o);
   if (!cts) return fail(cts.error());
+  std::vector<std::string> labels;
+  for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
+  auto study = defineStudy(o, labels);
+  if (!study) return fail(study.error());
+  StudyRunner::resolveSliceSpacings(study.value(), cts.value());
+  for (StudyCondition& c : study.value().conditions) {
+    if (o.trials > 0) c.trials = std::min(c.trials, o.trials);
+  }
   PreparedStudy prepared;
-  prepared.setup = StudySetupFile::text(known, o.cts, shard ? &*shard : nullptr);
+  // The shard deals out the trials of the run (after --trials); checked by checkOptions.
+  if (!o.shard.empty()) prepared.shard = StudyShard::parse(study.value(), o.shard).value();
+  prepared.setup = StudySetupFile::text(known, o.cts, prepared.shard ? &*prepared.shard : nullptr);
   if (store) {
     if (Status same = StudySetupFile::checkOrWrite(o.out, prepared.setup, !store->records().empty()); !same) {
       return fail("--out: " + same.error());
     }
   }
-  std::vector<std::string> labels;
-  for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
-  auto study = defineStudy(o, labels);
-  if (!study) return fail(study.error());
-  if (shard) shard = StudyShard::parse(study.value(), o.shard).value();  // the assignment of the full study
-  StudyRunner::resolveSliceSpacings(study.value(), cts.value());
-  for (StudyCondition& c : study.value().conditions) {
-    if (o.trials > 0) c.trials = std::min(c.trials, o.trials);
-  }
   prepared.study = std::move(study).value();
   prepared.cts = std::move(cts).value();
-  prepared.shard = shard;
   return prepared;
 }
 

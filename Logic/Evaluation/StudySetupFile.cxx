@@ -65,7 +65,9 @@ std::string StudySetupFile::text(const StudyDefinition& study, const std::vector
                      ctPaths.empty() ? "default" : fmt::format("{}", fmt::join(ctPaths, " ")), preset, d.cols, d.rows,
                      d.pixelSpacing_mm, d.sourceToDetector_mm, d.sourceToIsocentre_mm,
                      DrrRendererFactory::methodName(setup.method), setup.transgraphSpacing_mm, setup.seed,
-                     shard && shard->count() > 1 ? fmt::format("{}: {}\n", kShardKey, shard->text()) : "");
+                     shard && shard->count() > 1
+                         ? fmt::format("{}: {} of {} trials\n", kShardKey, shard->text(), shard->totalTrials())
+                         : "");
 }
 
 Status StudySetupFile::checkOrWrite(const fs::path& folder, const std::string& setupText, bool hasTrials) {

@@ -1,7 +1,7 @@
 #pragma once
 // StudySetupFile: DIR/setup.txt of an evaluation study's output folder: the options that change its results, one
 // "key: value" line each. Written on the first run and compared on every resume, so trials run with other options
-// are never mixed into one trials.csv (docs/evaluation.md "Resume"). A shard's folder also records "shard: K/N"; merging
+// are never mixed into one trials.csv (docs/evaluation.md "Resume"). A shard's folder also records "shard: K/N of T trials"; merging
 // shards requires their setups to be equal but for that line.
 
 #include <filesystem>
@@ -24,7 +24,8 @@ class StudySetupFile {
 
   /// The setup text of `study`: study, quick, cts (`ctPaths` as given; "default" when empty), preset (a preset file
   /// with its size and FNV-1a hash, so an edited file counts as another preset), detector, pixel_mm, sid_mm, sad_mm,
-  /// method, transgraph_spacing_mm, seed; then "shard: K/N" for a `shard` of more than one (none for the whole study).
+  /// method, transgraph_spacing_mm, seed; then "shard: K/N of T trials" for a `shard` of more than one (none for the
+  /// whole study).
   static std::string text(const StudyDefinition& study, const std::vector<std::string>& ctPaths,
                           const StudyShard* shard = nullptr);
 

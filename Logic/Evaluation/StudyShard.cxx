@@ -30,6 +30,7 @@ Result<StudyShard> StudyShard::create(const StudyDefinition& study, int index, i
     shard.m_firstPosition.emplace(c.name, position);
     position += c.trials;
   }
+  shard.m_totalTrials = position;
   return shard;
 }
 

@@ -91,7 +91,7 @@ TEST(StudySetupFile, AShardRecordsItsLineAndAMergeIgnoresOnlyThatLine) {
   const fct::StudyDefinition study = quickTable2();
   const std::string whole = StudySetupFile::text(study, {});
   const fct::StudyShard second = fct::StudyShard::create(study, 2, 3).value();
-  EXPECT_EQ(StudySetupFile::text(study, {}, &second), whole + "shard: 2/3\n");
+  EXPECT_EQ(StudySetupFile::text(study, {}, &second), whole + "shard: 2/3 of 6 trials\n");
   const fct::StudyShard oneOfOne = fct::StudyShard::create(study, 1, 1).value();
   EXPECT_EQ(StudySetupFile::text(study, {}, &oneOfOne), whole) << "shard 1/1 is the whole study";
 

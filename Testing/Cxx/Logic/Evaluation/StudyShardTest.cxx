@@ -49,6 +49,11 @@ TEST(StudyShard, DealsEveryTrialToOneShardEvenlyWithinEachConditionAndInAll) {
   int sum = 0;
   for (int n : all) sum += n;
   EXPECT_EQ(sum, total);
+
+  fct::StudyDefinition sample = study;  // a run of the first trial of each condition (--trials 1) over 4 shards
+  for (fct::StudyCondition& c : sample.conditions) c.trials = 1;
+  EXPECT_LE(spread(trialsPerShard(sample, 4)), 1);
+  EXPECT_EQ(fct::StudyShard::create(sample, 1, 4).value().totalTrials(), 18);
 }
 
 TEST(StudyShard, QuickTable2InThreeShardsGivesEachShardOneTrialOfTwoConditions) {
