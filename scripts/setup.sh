@@ -11,12 +11,16 @@ FCT_PACKAGES=(
   qt6-base-dev libqt6opengl6-dev libxkbcommon-dev libgl-dev libvtk9-dev libeigen3-dev libopencv-dev libdcmtk-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev libfmt-dev libtbb-dev libcli11-dev zlib1g-dev libopenigtlink-dev
   libxml2-dev
-  xvfb xauth plastimatch
+  xvfb xauth plastimatch parallel
 )
+# Opt-in: a one-node Slurm cluster for trying study-slurm.sbatch, installed only by scripts/slurm-local.sh.
+FCT_SLURM_PACKAGES=(slurm-wlm munge)
 
+# Installs those of the given packages (default: FCT_PACKAGES) that are missing.
 fct_install_packages() {
-  local missing=()
-  for pkg in "${FCT_PACKAGES[@]}"; do
+  local wanted=("$@") missing=()
+  ((${#wanted[@]})) || wanted=("${FCT_PACKAGES[@]}")
+  for pkg in "${wanted[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
       missing+=("$pkg")
     fi

@@ -1,7 +1,8 @@
 // fluoroct evaluate: runs one of the paper's studies (StudyCatalog) with simulated X-rays of known truth, writes every
 // trial to DIR/trials.csv (resumable), then DIR/report.md and PNG charts (StudyReport). The options that change results
 // (study, CTs, preset, detector, DRR method, ...) are kept in DIR/setup.txt (StudySetupFile); resuming with other
-// options is refused.
+// options is refused. --shard K/N runs only shard K of N (StudyShard) into its own folder; --merge DIR... gathers the
+// shard folders into one trials.csv, report and charts in --out, as one unsharded run would write them (StudyMerge).
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,9 +20,11 @@
 #include "CliSupport.h"
 #include "Drr/DrrRendererFactory.h"
 #include "Evaluation/StudyCatalog.h"
+#include "Evaluation/StudyMerge.h"
 #include "Evaluation/StudyReport.h"
 #include "Evaluation/StudyRunner.h"
 #include "Evaluation/StudySetupFile.h"
+#include "Evaluation/StudyShard.h"
 #include "Evaluation/TrialStore.h"
 #include "IO/Volume/CtLoader.h"
 #include "Registration/RegistrationSchedule.h"
@@ -43,6 +47,8 @@ struct EvaluateOptions {
   std::string detector;  ///< COLSxROWS; empty: the study's
   double pixel_mm = 0.0; ///< > 0: detector pixel size
   std::string method = "siddon";
+  std::string shard;               ///< K/N: run only shard K of N; empty: every trial
+  std::vector<std::string> merge;  ///< shard output folders to merge into --out instead of running trials
 };
 
 /// The Transgraph table cache of a run: inside its output folder, so tables are shared by its trials only.
@@ -167,75 +173,156 @@ Status prepareOutput(const fs::path& out) {
   return Ok{};
 }
 
-int runEvaluate(const EvaluateOptions& o) {
-  // The study and options are checked before anything is loaded (the CT labels are placeholders here).
+/// A study ready to run or merge: its definition over the loaded CTs (trial counts after --trials), the CTs, its
+/// shard (--shard) and its setup text.
+struct PreparedStudy {
+  StudyDefinition study;
+  std::vector<StudyCt> cts;
+  std::optional<StudyShard> shard;
+  std::string setup;
+};
+
+/// Checks the options before anything is loaded or written; returns the study they define (over a placeholder CT
+/// label). Fails with the message to report.
+Result<StudyDefinition> checkOptions(const EvaluateOptions& o) {
   auto known = defineStudy(o, {"ct"});
-  if (!known) return reportError(known.error());
+  if (!known) return fail(known.error());
   if (o.jobs < 1 || o.jobs > StudyRunner::kMaxJobs) {
-    return reportError(fmt::format("--jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, o.jobs));
+    return fail(fmt::format("--jobs must be between 1 and {}, got {}", StudyRunner::kMaxJobs, o.jobs));
   }
-  if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
-  if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
-  auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
-  if (!store) return reportError("--out: " + store.error());
+  if (o.trials < 0) return fail(fmt::format("--trials must be positive, got {}", o.trials));
+  if (!o.shard.empty()) {
+    if (auto shard = StudyShard::parse(known.value(), o.shard); !shard) return fail("--shard: " + shard.error());
+  }
+  return known;
+}
+
+/// Loads the CTs of the checked study `known` and defines it over them. For a run, checks (or writes) DIR/setup.txt
+/// against the trials in `store`; a merge checks its folders later (StudyMerge). Fails with the message to report.
+Result<PreparedStudy> prepareStudy(const EvaluateOptions& o, const StudyDefinition& known, const TrialStore* store) {
   // The CTs are found before setup.txt is written, so that a run without them leaves no setup behind.
   auto cts = loadCts(o);
-  if (!cts) return reportError(cts.error());
-  const std::string setup = StudySetupFile::text(known.value(), o.cts);
-  if (Status same = StudySetupFile::checkOrWrite(o.out, setup, !store.value().records().empty()); !same) {
-    return reportError("--out: " + same.error());
-  }
+  if (!cts) return fail(cts.error());
   std::vector<std::string> labels;
   for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
   auto study = defineStudy(o, labels);
-  if (!study) return reportError(study.error());
+  if (!study) return fail(study.error());
   StudyRunner::resolveSliceSpacings(study.value(), cts.value());
-  std::size_t total = 0;
   for (StudyCondition& c : study.value().conditions) {
     if (o.trials > 0) c.trials = std::min(c.trials, o.trials);
-    total += static_cast<std::size_t>(c.trials);
   }
-  const StudySetup& s = study.value().setup;
-  fmt::print(stderr, "evaluate: study '{}'{} on {}: {} conditions, {} trials, {} job(s); preset {}, detector {}x{} at {:g} "
-                     "mm, {} DRRs\n",
-             o.study, o.quick ? " (quick)" : "", fmt::join(labels, ", "), study.value().conditions.size(), total, o.jobs,
-             s.preset, s.detector.cols, s.detector.rows, s.detector.pixelSpacing_mm,
-             DrrRendererFactory::methodName(s.method));
+  PreparedStudy prepared;
+  // The shard deals out the trials of the run (after --trials); checked by checkOptions.
+  if (!o.shard.empty()) prepared.shard = StudyShard::parse(study.value(), o.shard).value();
+  prepared.setup = StudySetupFile::text(known, o.cts, prepared.shard ? &*prepared.shard : nullptr);
+  if (store) {
+    if (Status same = StudySetupFile::checkOrWrite(o.out, prepared.setup, !store->records().empty()); !same) {
+      return fail("--out: " + same.error());
+    }
+  }
+  prepared.study = std::move(study).value();
+  prepared.cts = std::move(cts).value();
+  return prepared;
+}
+
+/// The report's notes: the command (a merge's as the one unsharded run it stands for), the setup, the shard, and
+/// StudyRunner's notes.
+std::vector<std::string> reportNotes(const EvaluateOptions& o, const PreparedStudy& p) {
+  std::vector<std::string> notes = StudyRunner::notes(p.study, p.cts);
+  if (p.shard && p.shard->count() > 1) {
+    notes.insert(notes.begin(), fmt::format("shard {}: this folder holds only that shard's trials; merge the {} shard "
+                                            "folders with `--merge` for the report of the whole study",
+                                            p.shard->text(), p.shard->count()));
+  }
+  notes.insert(notes.begin(),
+               fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}{}{}{}{} --method {}`; setup (compared on "
+                           "resume, DIR/setup.txt): {}",
+                           o.study, o.quick ? " --quick" : "", o.out,
+                           p.shard ? " --shard " + p.shard->text() : "",
+                           o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
+                           o.cts.empty() ? "" : fmt::format(" --ct {}", fmt::join(o.cts, " ")),
+                           o.preset.empty() ? "" : " --preset " + o.preset,
+                           o.detector.empty() ? "" : " --detector " + o.detector,
+                           o.pixel_mm > 0 ? fmt::format(" --pixel-mm {:g}", o.pixel_mm) : "", o.method,
+                           oneLine(p.setup)));
+  return notes;
+}
+
+/// Writes the report and charts of `records` into --out; returns the names of the files written.
+Result<std::vector<std::string>> writeReport(const EvaluateOptions& o, const PreparedStudy& p,
+                                             const std::vector<TrialRecord>& records) {
+  auto written = StudyReport::write(p.study, records, reportNotes(o, p), o.out);
+  if (!written) return fail(written.error());
+  std::vector<std::string> names;
+  for (const fs::path& path : written.value()) names.push_back(path.filename().string());
+  return names;
+}
+
+/// --merge: the trials of the shard folders into one trials.csv, report and charts in --out, as one run writes them.
+int runMerge(const EvaluateOptions& o, const StudyDefinition& known) {
+  if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
+  auto prepared = prepareStudy(o, known, nullptr);
+  if (!prepared) return reportError(prepared.error());
+  const PreparedStudy& p = prepared.value();
+  std::vector<fs::path> folders(o.merge.begin(), o.merge.end());
+  auto records = StudyMerge::collect(p.study, p.setup, folders);
+  if (!records) return reportError("--merge: " + records.error());
+  if (Status saved = StudyMerge::write(o.out, p.setup, records.value()); !saved) {
+    return reportError("--out: " + saved.error());
+  }
+  auto names = writeReport(o, p, records.value());
+  if (!names) return reportError(names.error());
+  fmt::print("{}: merged {} trials from {} shard folders; wrote {} and {}\n", o.study, records.value().size(),
+             folders.size(), (fs::path(o.out) / "trials.csv").string(), fmt::join(names.value(), ", "));
+  return 0;
+}
+
+int runEvaluate(const EvaluateOptions& o) {
+  auto known = checkOptions(o);
+  if (!known) return reportError(known.error());
+  if (!o.merge.empty()) return runMerge(o, known.value());
+  if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
+  auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
+  if (!store) return reportError("--out: " + store.error());
+  auto prepared = prepareStudy(o, known.value(), &store.value());
+  if (!prepared) return reportError(prepared.error());
+  const PreparedStudy& p = prepared.value();
+  std::size_t total = 0;
+  for (const StudyCondition& c : p.study.conditions) total += static_cast<std::size_t>(c.trials);
+  std::vector<std::string> labels;
+  for (const StudyCt& ct : p.cts) labels.push_back(ct.label);
+  const StudySetup& s = p.study.setup;
+  fmt::print(stderr, "evaluate: study '{}'{}{} on {}: {} conditions, {} trials, {} job(s); preset {}, detector {}x{} at "
+                     "{:g} mm, {} DRRs\n",
+             o.study, o.quick ? " (quick)" : "", p.shard ? fmt::format(", shard {}", p.shard->text()) : "",
+             fmt::join(labels, ", "), p.study.conditions.size(), total, o.jobs, s.preset, s.detector.cols,
+             s.detector.rows, s.detector.pixelSpacing_mm, DrrRendererFactory::methodName(s.method));
 
   StudyRunOptions run;
   run.jobs = o.jobs;
   run.cancel = InterruptGuard::cancelFlag();
+  run.shard = p.shard ? &*p.shard : nullptr;
   run.onMessage = [](const std::string& text) { fmt::print(stderr, "evaluate: {}\n", text); };
-  run.onTrial = [](const StudyProgress& p) {
-    const TrialRecord& r = p.record;
+  run.onTrial = [](const StudyProgress& progress) {
+    const TrialRecord& r = progress.record;
     fmt::print(stderr, "[{}/{}] {} trial {}: initial sTRE {:.2f} mm -> {:.3f} mm (max {:.3f}) {}{} {:.1f} s{}, {} DRRs\n",
-               p.finished, p.toRun, r.condition, r.trial, r.initialStre_mm, r.error.streMean_mm, r.error.streMax_mm,
+               progress.finished, progress.toRun, r.condition, r.trial, r.initialStre_mm, r.error.streMean_mm,
+               r.error.streMax_mm,
                r.status == TrialStatus::Ok ? (r.success ? "success" : "FAILURE") : trialStatusName(r.status),
                r.reason.empty() ? "" : " (" + r.reason + ")", r.seconds,
                r.setupSeconds > 0 ? fmt::format(" (+{:.1f} s tables)", r.setupSeconds) : "", r.drrs);
   };
   auto summary = [&] {
     const InterruptGuard interrupt;  // Ctrl-C stops the trials (the finished ones stay saved) until the run returns
-    return StudyRunner::run(study.value(), cts.value(), store.value(), run);
+    return StudyRunner::run(p.study, p.cts, store.value(), run);
   }();
   if (!summary) return reportError(summary.error());
 
-  std::vector<std::string> notes = StudyRunner::notes(study.value(), cts.value());
-  notes.insert(notes.begin(),
-               fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}{}{}{} --method {}`; setup (compared on "
-                           "resume, DIR/setup.txt): {}",
-                           o.study, o.quick ? " --quick" : "", o.out,
-                           o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
-                           o.cts.empty() ? "" : fmt::format(" --ct {}", fmt::join(o.cts, " ")),
-                           o.preset.empty() ? "" : " --preset " + o.preset,
-                           o.detector.empty() ? "" : " --detector " + o.detector,
-                           o.pixel_mm > 0 ? fmt::format(" --pixel-mm {:g}", o.pixel_mm) : "", o.method, oneLine(setup)));
-  auto written = StudyReport::write(study.value(), store.value().records(), notes, o.out);
-  if (!written) return reportError(written.error());
-  std::vector<std::string> names;
-  for (const fs::path& path : written.value()) names.push_back(path.filename().string());
-  fmt::print("{}: ran {} trials ({} failed), skipped {} already done; wrote {} and {}\n", o.study, summary.value().ran,
-             summary.value().failed, summary.value().skipped, store.value().path().string(), fmt::join(names, ", "));
+  auto names = writeReport(o, p, store.value().records());
+  if (!names) return reportError(names.error());
+  fmt::print("{}{}: ran {} trials ({} failed), skipped {} already done; wrote {} and {}\n", o.study,
+             p.shard ? " shard " + p.shard->text() : "", summary.value().ran, summary.value().failed,
+             summary.value().skipped, store.value().path().string(), fmt::join(names.value(), ", "));
   if (summary.value().cancelled) {
     return reportError("cancelled; the finished trials are saved: re-run the same command to resume");
   }
@@ -269,6 +356,14 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
                       "DRR method: siddon (exact) or transgraph (tables built around each trial's start pose, cached "
                       "in OUT/transgraph-cache)")
       ->capture_default_str();
+  CLI::Option* shard = command->add_option(
+      "--shard", options->shard,
+      "Run only shard K of N, as K/N (e.g. 2/8), into its own --out; the trials are dealt round robin, so every shard "
+      "gets a share of every condition");
+  command->add_option("--merge", options->merge,
+                      "Merge these shard folders (of one study run with --shard K/N, all K, and the same options as "
+                      "given here) into --out instead of running trials")
+      ->excludes(shard);
   command->callback([&action, options] { action = [options] { return runEvaluate(*options); }; });
 }
 

@@ -160,11 +160,14 @@ void say(const StudyRunOptions& options, const std::string& text) {
 /// True once the run's cancel flag is set.
 bool cancelRequested(const StudyRunOptions& options) { return options.cancel && options.cancel->load(); }
 
-/// The trials of `study` that `store` does not hold yet, by condition then trial index; adds the others to `skipped`.
-std::vector<PendingTrial> findPendingTrials(const StudyDefinition& study, const TrialStore& store, int& skipped) {
+/// The trials of `study` (of `shard`, when given) that `store` does not hold yet, by condition then trial index; adds
+/// the others of the shard to `skipped`.
+std::vector<PendingTrial> findPendingTrials(const StudyDefinition& study, const StudyShard* shard,
+                                            const TrialStore& store, int& skipped) {
   std::vector<PendingTrial> pending;
   for (const StudyCondition& c : study.conditions) {
     for (int t = 0; t < c.trials; ++t) {
+      if (shard && !shard->holds(c.name, t)) continue;
       if (store.isDone(study.name, c.name, t)) {
         ++skipped;
       } else {
@@ -396,7 +399,7 @@ Result<StudyRunSummary> StudyRunner::run(const StudyDefinition& study, const std
   if (!baseSchedule) return fail(baseSchedule.error());
 
   StudyRunSummary summary;
-  const std::vector<PendingTrial> pending = findPendingTrials(study, store, summary.skipped);
+  const std::vector<PendingTrial> pending = findPendingTrials(study, options.shard, store, summary.skipped);
   if (summary.skipped > 0) {
     say(options, fmt::format("{} trials already in {}; skipping them", summary.skipped, store.path().string()));
   }

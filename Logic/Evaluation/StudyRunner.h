@@ -9,6 +9,7 @@
 // Transgraph method: each trial gets a fresh copy of the case, so its tables are built around that trial's START pose
 // (the truth is unknown at run time), or loaded from setup.transgraphCacheDir when another condition with the same
 // registration CT, views and start (same trial index) built them; the time goes to TrialRecord::setupSeconds.
+// With a StudyShard only that shard's trials are run (and only the CTs and cases they need are prepared).
 
 #include <Eigen/Geometry>
 
@@ -19,6 +20,7 @@
 
 #include "Base/Result.h"
 #include "Evaluation/StudyDefinition.h"
+#include "Evaluation/StudyShard.h"
 #include "Evaluation/TrialStore.h"
 #include "Image/BoneSurface.h"
 #include "Image/Volume.h"
@@ -45,12 +47,13 @@ struct StudyRunOptions {
   std::function<void(const StudyProgress&)> onTrial;             ///< after each trial (serialized)
   std::function<void(const std::string&)> onMessage;             ///< preparation steps (serialized)
   const std::atomic<bool>* cancel = nullptr;                     ///< set to stop: running trials end as Cancelled
+  const StudyShard* shard = nullptr;                             ///< run only this shard's trials (null: all)
 };
 
 /// What a run did.
 struct StudyRunSummary {
   int ran = 0;           ///< trials run now (any status)
-  int skipped = 0;       ///< trials already in the store
+  int skipped = 0;       ///< trials already in the store (of this run's shard)
   int failed = 0;        ///< trials whose registration returned an error
   bool cancelled = false;
 };

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <sstream>
+#include <string_view>
 
 #include "Base/TextFile.h"
 #include "Drr/DrrRendererFactory.h"
@@ -13,7 +14,40 @@ namespace fct {
 
 namespace fs = std::filesystem;
 
-std::string StudySetupFile::text(const StudyDefinition& study, const std::vector<std::string>& ctPaths) {
+namespace {
+
+/// Each line that differs between setup texts `now` and `stored`, as "'now line' NOW_WORD, 'stored line' STORED_WORD"
+/// joined by "; " ("(none)" for a line one of them lacks); empty when they are equal.
+std::string differences(const std::string& now, const std::string& stored, std::string_view nowWord,
+                        std::string_view storedWord) {
+  std::string out;
+  const auto add = [&](const std::string& a, const std::string& b) {
+    out += fmt::format("{}'{}' {}, '{}' {}", out.empty() ? "" : "; ", b, nowWord, a, storedWord);
+  };
+  std::istringstream was(stored), is(now);
+  for (std::string a, b; std::getline(is, b);) {
+    if (!std::getline(was, a)) a = "(none)";
+    if (a != b) add(a, b);
+  }
+  for (std::string a; std::getline(was, a);) add(a, "(none)");
+  return out;
+}
+
+/// `setupText` without its shard line.
+std::string withoutShard(const std::string& setupText) {
+  const std::string prefix = std::string(StudySetupFile::kShardKey) + ": ";
+  std::string out;
+  std::istringstream lines(setupText);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(prefix, 0) != 0) out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string StudySetupFile::text(const StudyDefinition& study, const std::vector<std::string>& ctPaths,
+                                 const StudyShard* shard) {
   const StudySetup& setup = study.setup;
   const StandardViewOptions& d = setup.detector;
   std::string preset = setup.preset;
@@ -26,11 +60,14 @@ std::string StudySetupFile::text(const StudyDefinition& study, const std::vector
     }
   }
   return fmt::format("study: {}\nquick: {}\ncts: {}\npreset: {}\ndetector: {}x{}\npixel_mm: {:g}\nsid_mm: {:g}\n"
-                     "sad_mm: {:g}\nmethod: {}\ntransgraph_spacing_mm: {:g}\nseed: {}\n",
+                     "sad_mm: {:g}\nmethod: {}\ntransgraph_spacing_mm: {:g}\nseed: {}\n{}",
                      study.name, study.quick ? "yes" : "no",
                      ctPaths.empty() ? "default" : fmt::format("{}", fmt::join(ctPaths, " ")), preset, d.cols, d.rows,
                      d.pixelSpacing_mm, d.sourceToDetector_mm, d.sourceToIsocentre_mm,
-                     DrrRendererFactory::methodName(setup.method), setup.transgraphSpacing_mm, setup.seed);
+                     DrrRendererFactory::methodName(setup.method), setup.transgraphSpacing_mm, setup.seed,
+                     shard && shard->count() > 1
+                         ? fmt::format("{}: {} of {} trials\n", kShardKey, shard->text(), shard->totalTrials())
+                         : "");
 }
 
 Status StudySetupFile::checkOrWrite(const fs::path& folder, const std::string& setupText, bool hasTrials) {
@@ -43,18 +80,24 @@ Status StudySetupFile::checkOrWrite(const fs::path& folder, const std::string& s
                             folder.string(), kFileName));
   }
   if (stored.value() == setupText) return Ok{};
-  std::string differences;
-  std::istringstream was(stored.value()), now(setupText);
-  for (std::string a, b; std::getline(now, b);) {
-    if (!std::getline(was, a)) a = "(none)";
-    if (a != b) differences += fmt::format("{}'{}' now, '{}' stored", differences.empty() ? "" : "; ", b, a);
-  }
-  for (std::string a; std::getline(was, a);) {
-    differences += fmt::format("{}'(none)' now, '{}' stored", differences.empty() ? "" : "; ", a);
-  }
   return fail(fmt::format("{} holds trials run with other options ({}); resume with the same options as in {}, or use "
                           "another output folder",
-                          folder.string(), differences, file.string()));
+                          folder.string(), differences(setupText, stored.value(), "now", "stored"), file.string()));
+}
+
+Status StudySetupFile::checkShard(const fs::path& folder, const std::string& setupText) {
+  const fs::path file = folder / kFileName;
+  auto stored = TextFile::read(file);
+  if (!stored) {
+    return fail(fmt::format("{} has no {}, so it is not the output folder of a study shard (or made by an older "
+                            "fluoroct); give the folders that `fluoroct evaluate --shard K/N --out DIR` wrote",
+                            folder.string(), kFileName));
+  }
+  const std::string found = differences(setupText, withoutShard(stored.value()), "for the merge", "in the shard");
+  if (found.empty()) return Ok{};
+  return fail(fmt::format("shard folder {} was run with other options than this merge ({}); merge with the options the "
+                          "shards were run with (see {}), and only shards of one study run",
+                          folder.string(), found, file.string()));
 }
 
 }  // namespace fct

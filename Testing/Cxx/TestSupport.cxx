@@ -33,14 +33,16 @@ std::filesystem::path scratchDir() {
 
 std::filesystem::path cliPath() { return FCT_CLI_PATH; }
 
-ProcessResult runCli(const std::string& arguments) {
+std::filesystem::path scriptPath(const std::string& name) { return std::filesystem::path(FCT_SCRIPT_DIR) / name; }
+
+ProcessResult runCommand(const std::string& commandLine) {
   // Not scratchDir(): that would empty the calling test's folder before every command.
   const auto dir = std::filesystem::temp_directory_path() / "fluoroct_tests" / "cli_capture";
   std::filesystem::create_directories(dir);
   const auto outPath = dir / fmt::format("out_{}.txt", ::getpid());
   const auto errPath = dir / fmt::format("err_{}.txt", ::getpid());
-  const std::string command = fmt::format("'{}' {} > '{}' 2> '{}' < /dev/null", cliPath().string(), arguments,
-                                          outPath.string(), errPath.string());
+  const std::string command =
+      fmt::format("{} > '{}' 2> '{}' < /dev/null", commandLine, outPath.string(), errPath.string());
   const int status = std::system(command.c_str());
   ProcessResult result;
   result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -53,6 +55,10 @@ ProcessResult runCli(const std::string& arguments) {
   result.out = slurp(outPath);
   result.err = slurp(errPath);
   return result;
+}
+
+ProcessResult runCli(const std::string& arguments) {
+  return runCommand(fmt::format("'{}' {}", cliPath().string(), arguments));
 }
 
 }  // namespace fct::test

@@ -16,6 +16,8 @@ std::filesystem::path fixtureDir();
 std::filesystem::path scratchDir();
 /// Path of the built `fluoroct` command-line program.
 std::filesystem::path cliPath();
+/// Path of a script in the repository's scripts/ folder, e.g. scriptPath("study-parallel.sh").
+std::filesystem::path scriptPath(const std::string& name);
 
 /// Output of a finished process.
 struct ProcessResult {
@@ -23,6 +25,8 @@ struct ProcessResult {
   std::string out;    ///< captured stdout
   std::string err;    ///< captured stderr
 };
+/// Runs a shell command line (quoted by the caller) with no standard input and captures its output.
+ProcessResult runCommand(const std::string& commandLine);
 /// Runs `fluoroct` with the given argument string (shell-quoted by the caller) and captures its output.
 ProcessResult runCli(const std::string& arguments);
 

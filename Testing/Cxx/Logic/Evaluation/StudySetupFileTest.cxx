@@ -1,10 +1,12 @@
 // StudySetupFile: the setup text of a study, written on the first run, accepted on a resume with the same options and
-// refused, naming each difference, with other options or without a setup file.
+// refused, naming each difference, with other options or without a setup file; a shard's line, the one line a merge
+// ignores.
 #include <gtest/gtest.h>
 
 #include "Base/TextFile.h"
 #include "Evaluation/StudyCatalog.h"
 #include "Evaluation/StudySetupFile.h"
+#include "Evaluation/StudyShard.h"
 #include "TestSupport.h"
 
 namespace {
@@ -82,4 +84,27 @@ TEST(StudySetupFile, TrialsWithoutASetupFileAreRefusedAndAnUnwritableFolderFails
   const fct::Status unwritable = StudySetupFile::checkOrWrite(dir / "no" / "such" / "folder", text, false);
   ASSERT_FALSE(unwritable.ok());
   EXPECT_NE(unwritable.error().find("setup.txt"), std::string::npos) << unwritable.error();
+}
+
+TEST(StudySetupFile, AShardRecordsItsLineAndAMergeIgnoresOnlyThatLine) {
+  const fs::path dir = fct::test::scratchDir();
+  const fct::StudyDefinition study = quickTable2();
+  const std::string whole = StudySetupFile::text(study, {});
+  const fct::StudyShard second = fct::StudyShard::create(study, 2, 3).value();
+  EXPECT_EQ(StudySetupFile::text(study, {}, &second), whole + "shard: 2/3 of 6 trials\n");
+  const fct::StudyShard oneOfOne = fct::StudyShard::create(study, 1, 1).value();
+  EXPECT_EQ(StudySetupFile::text(study, {}, &oneOfOne), whole) << "shard 1/1 is the whole study";
+
+  ASSERT_TRUE(StudySetupFile::checkOrWrite(dir, StudySetupFile::text(study, {}, &second), false).ok());
+  const fct::Status same = StudySetupFile::checkShard(dir, whole);
+  EXPECT_TRUE(same.ok()) << same.error();
+  fct::StudyDefinition other = study;
+  other.setup.preset = "paper";
+  const fct::Status differs = StudySetupFile::checkShard(dir, StudySetupFile::text(other, {}));
+  ASSERT_FALSE(differs.ok());
+  EXPECT_NE(differs.error().find("('preset: paper' for the merge, 'preset: fast' in the shard)"), std::string::npos)
+      << differs.error();
+  const fct::Status missing = StudySetupFile::checkShard(dir / "none", whole);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("has no setup.txt"), std::string::npos) << missing.error();
 }
