@@ -60,7 +60,9 @@ Result<SimulatedCase> SimulatedCaseWriter::write(const std::vector<ViewSpec>& vi
     }
   }
   for (const SimulatedExtraImage& extra : extraImages) {
-    if (Status written = ImageFileWriter::writeNrrd2d(extra.image, dir / extra.fileName, extra.pixelSpacing_mm);
+    const std::filesystem::path path = dir / extra.fileName;
+    if (Status written = path.extension() == ".png" ? ImageFileWriter::writePng16(extra.image, path, 0.0f, 65535.0f)
+                                                    : ImageFileWriter::writeNrrd2d(extra.image, path, extra.pixelSpacing_mm);
         !written) {
       return fail(written.error());
     }

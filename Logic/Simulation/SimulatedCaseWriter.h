@@ -24,9 +24,10 @@ struct SimulatedCase {
   std::vector<double> maxLineIntegral;   ///< per view: the largest line integral p = -ln(I / I0) of its noiseless image
 };
 
-/// An extra 2D float image written as NRRD into the case folder (e.g. a view's distortion field).
+/// An extra 2D float image written into the case folder: float NRRD (e.g. a view's distortion field), or a 16-bit PNG
+/// like the views' when the name ends in .png (e.g. a grid plate image).
 struct SimulatedExtraImage {
-  std::string fileName;                                   ///< file name inside the case folder, ending in .nrrd
+  std::string fileName;                                   ///< file name inside the case folder, ending in .nrrd or .png
   FloatImage image;                                       ///< the values
   Eigen::Vector2d pixelSpacing_mm{1.0, 1.0};              ///< written as the NRRD spacings
 };
