@@ -185,8 +185,7 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       if (physical && options->physical.gridPitch_mm > 0.0) {
         for (const ViewSpec& view : simulated.value().views) {
           fmt::print("wrote {} (dewarp calibration grid, pitch {} mm)\n",
-                     (std::filesystem::path(options->out) / (view.name + "_grid.png")).string(),
-                     options->physical.gridPitch_mm);
+                     (view.imagePath.parent_path() / (view.name + "_grid.png")).string(), options->physical.gridPitch_mm);
         }
       }
       if (registrationCt) {

@@ -105,7 +105,14 @@ Result<std::vector<PixelCircle>> GridBeadDetector::detect(const FloatImage& imag
       const double radius = std::sqrt(stats.at<int>(label, cv::CC_STAT_AREA) / M_PI);
       if (radius < o.minRadius_px || radius > o.maxRadius_px) continue;
       if (std::max(width, height) > 3 * std::min(width, height)) continue;
-      if (left < 2 || top < 2 || left + width > image.cols - 2 || top + height > image.rows - 2) continue;
+      // The centroid's disc and ring must lie on the image, or the border cuts the bead's weight off one side.
+      const double window = 1.6 * radius + 1.5;
+      const Eigen::Vector2d start(centroids.at<double>(label, 0), centroids.at<double>(label, 1));
+      const double reach = window + 4.0;
+      if (start.x() < reach || start.y() < reach || start.x() > image.cols - 1 - reach ||
+          start.y() > image.rows - 1 - reach) {
+        continue;
+      }
       bool nearInvalid = false;
       for (int row = top; row < top + height && !nearInvalid; ++row) {
         for (int col = left; col < left + width; ++col) {
@@ -116,8 +123,7 @@ Result<std::vector<PixelCircle>> GridBeadDetector::detect(const FloatImage& imag
         }
       }
       if (nearInvalid) continue;
-      Eigen::Vector2d centre(centroids.at<double>(label, 0), centroids.at<double>(label, 1));
-      const double window = 1.6 * radius + 1.5;
+      Eigen::Vector2d centre = start;
       for (int pass = 0; pass < 2; ++pass) centre = weightedCentroid(dark, centre, window);
       beads.push_back({centre, radius});
     }

@@ -6,9 +6,10 @@
 // larger than the biggest bead (which removes every dark spot smaller than the disc); the relative darkness is
 // (background − smoothed) / background. Pixels darker than max(minContrast, 0.35 × the darkness's 99.5th percentile)
 // form 8-connected candidates; a candidate is kept when its equivalent radius is within minRadius_px..maxRadius_px,
-// it is not elongated (bounding box sides within 3:1) and it keeps 2 px away from the image border and invalid
-// pixels. Its centre is the darkness-weighted centroid of the unsmoothed image over a disc of 1.6 × its radius +
-// 1.5 px, after subtracting the median darkness of the ring just outside (twice, re-centred).
+// it is not elongated (bounding box sides within 3:1), it keeps 2 px away from invalid pixels, and its centroid's
+// disc and ring (below) lie on the image. Its centre is the darkness-weighted centroid of the unsmoothed image over a
+// disc of 1.6 × its radius + 1.5 px, after subtracting the median darkness of the ring 1..3 px outside it (twice,
+// re-centred).
 
 #include <vector>
 
