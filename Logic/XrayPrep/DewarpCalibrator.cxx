@@ -8,6 +8,7 @@
 #include <deque>
 #include <limits>
 #include <map>
+#include <optional>
 
 namespace fct {
 
@@ -182,9 +183,18 @@ Fit fitBeads(const DewarpField& shape, const std::vector<DewarpBead>& beads, Inc
   return fit;
 }
 
-/// The field of a fit (the shape gives the size and degree).
-DewarpField fieldOf(const DewarpField& shape, const Fit& fit) {
-  return DewarpField::create(shape.cols(), shape.rows(), shape.degree(), fit.col_px, fit.row_px).value();
+/// The field of a fit (the shape gives the size and degree); nullopt when the fit is not finite (degenerate beads).
+std::optional<DewarpField> fieldOf(const DewarpField& shape, const Fit& fit) {
+  auto field = DewarpField::create(shape.cols(), shape.rows(), shape.degree(), fit.col_px, fit.row_px);
+  if (!field || !std::isfinite(fit.a) || !std::isfinite(fit.b) || !fit.t.allFinite()) return std::nullopt;
+  return std::move(field).value();
+}
+
+/// The error of a fit that the beads do not determine.
+Error undeterminedFit(int degree) {
+  return fail(fmt::format("the beads do not determine a degree-{} dewarp (the fit is singular); use a plate whose "
+                          "grid covers the whole image, or a lower --degree",
+                          degree));
 }
 
 /// Residual of bead k under a fit.
@@ -198,10 +208,11 @@ double crossValidatedRms(const DewarpField& shape, const std::vector<DewarpBead>
   int count = 0;
   for (int fold = 0; fold < kFolds; ++fold) {
     const Fit fit = fitBeads(shape, beads, [&](std::size_t k) { return beads[k].used && int(k % kFolds) != fold; });
-    const DewarpField field = fieldOf(shape, fit);
+    const auto field = fieldOf(shape, fit);
+    if (!field) return std::numeric_limits<double>::infinity();
     for (std::size_t k = fold; k < beads.size(); k += kFolds) {
       if (!beads[k].used) continue;
-      const double r = residual(field, fit, beads[k]);
+      const double r = residual(*field, fit, beads[k]);
       sum += r * r;
       ++count;
     }
@@ -250,9 +261,10 @@ Result<DewarpCalibrationResult> DewarpCalibrator::calibrate(const FloatImage& gr
   {
     const DewarpField shape = DewarpField::identity(grid.cols, grid.rows, screenDegree).value();
     const Fit fit = fitBeads(shape, beads, [](std::size_t) { return true; });
-    const DewarpField field = fieldOf(shape, fit);
+    const auto field = fieldOf(shape, fit);
+    if (!field) return undeterminedFit(screenDegree);
     std::vector<double> residuals;
-    for (const DewarpBead& bead : beads) residuals.push_back(residual(field, fit, bead));
+    for (const DewarpBead& bead : beads) residuals.push_back(residual(*field, fit, bead));
     const double limit = std::max(0.5, 5.0 * 1.4826 * median(residuals));
     for (std::size_t k = 0; k < beads.size(); ++k) beads[k].used = residuals[k] <= limit;
   }
@@ -269,11 +281,13 @@ Result<DewarpCalibrationResult> DewarpCalibrator::calibrate(const FloatImage& gr
   for (int degree = lowest; degree <= highest && used >= beadsNeeded(degree); ++degree) {
     const DewarpField shape = DewarpField::identity(grid.cols, grid.rows, degree).value();
     const Fit fit = fitBeads(shape, beads, [&](std::size_t k) { return beads[k].used; });
-    const DewarpField field = fieldOf(shape, fit);
+    const auto field = fieldOf(shape, fit);
+    if (!field) continue;  // a degree the beads do not determine is not a candidate
     double sum = 0.0;
-    for (const DewarpBead& bead : beads) sum += bead.used ? std::pow(residual(field, fit, bead), 2) : 0.0;
+    for (const DewarpBead& bead : beads) sum += bead.used ? std::pow(residual(*field, fit, bead), 2) : 0.0;
     result.degrees.push_back({degree, std::sqrt(sum / used), o.degree ? 0.0 : crossValidatedRms(shape, beads)});
   }
+  if (result.degrees.empty()) return undeterminedFit(lowest);
   int chosen = o.degree;
   if (!chosen) {
     double best = std::numeric_limits<double>::infinity();
@@ -285,7 +299,9 @@ Result<DewarpCalibrationResult> DewarpCalibrator::calibrate(const FloatImage& gr
 
   const DewarpField shape = DewarpField::identity(grid.cols, grid.rows, chosen).value();
   const Fit fit = fitBeads(shape, beads, [&](std::size_t k) { return beads[k].used; });
-  result.field = fieldOf(shape, fit);
+  const auto field = fieldOf(shape, fit);
+  if (!field) return undeterminedFit(chosen);
+  result.field = *field;
   double sum = 0.0, largest = 0.0;
   for (DewarpBead& bead : beads) {
     bead.ideal_px = fit.lattice(bead.lattice);
