@@ -55,6 +55,7 @@ Result<SimulatedCase> SimulatedCaseWriter::write(const std::vector<ViewSpec>& vi
   for (std::size_t n = 0; n < views.size(); ++n) {
     result.views[n].imagePath = dir / (views[n].name + ".png");
     result.views[n].frame = 0;
+    result.views[n].dewarpPath.clear();  // the simulated images are not from the input views' intensifier
     if (Status written = ImageFileWriter::writePng16(images[n], result.views[n].imagePath, 0.0f, 65535.0f); !written) {
       return fail(written.error());
     }

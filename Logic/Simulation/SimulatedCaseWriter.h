@@ -40,7 +40,8 @@ class SimulatedCaseWriter {
   static Status checkViews(const std::vector<ViewSpec>& views);
 
   /// Writes into `outDir` (created if missing): <view>.png (16-bit, the image's values rounded and clamped to
-  /// 0..65535, MONOCHROME2), the extra images, views.json (the views with their image paths), truth_pose.json
+  /// 0..65535, MONOCHROME2), the extra images, views.json (the views with their image paths and without any input
+  /// view's dewarp file, which does not describe simulated images), truth_pose.json
   /// (T_world_from_ct) and simulation.json (`parameters` after the keys views, pose and T_world_from_ct). Returns
   /// the written case with maxLineIntegral empty (the caller fills it). Fails on a view/image count mismatch, bad
   /// view names, or an unwritable folder or file.
