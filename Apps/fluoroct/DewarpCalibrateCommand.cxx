@@ -72,7 +72,9 @@ void registerDewarpCalibrateCommand(CLI::App& app, CommandAction& action) {
       fmt::print("{} beads on the grid around the centre bead ({} more found off it)\n", result.beads.size(),
                  result.unindexedBeadCount);
       fmt::print("ideal lattice: pitch {:.3f} px, rotation {:.3f} deg", r.latticePitch_px, r.latticeRotation_deg);
-      if (r.magnification > 0.0) fmt::print(", magnification {:.4f} at {} mm pixels", r.magnification, calibration.pixelSpacing_mm);
+      if (r.magnification > 0.0) {
+        fmt::print(", magnification {:.4f} at {} mm pixels", r.magnification, calibration.pixelSpacing_mm);
+      }
       fmt::print("\n{:>6}  {:>14}  {:>26}\n", "degree", "fit RMS (px)", "cross-validated RMS (px)");
       for (const DewarpDegreeResidual& d : result.degrees) {
         fmt::print("{:>6}  {:>14.4f}  {:>26}\n", d.degree, d.fitRms_px,

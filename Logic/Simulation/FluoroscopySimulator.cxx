@@ -60,7 +60,9 @@ Status validate(const FluoroscopyOptions& o) {
   if (bad(o.collimatorRadiusFraction, 0.0, 1.5)) {
     return fail(fmt::format("collimator radius fraction must be 0 (none) or up to 1.5, got {}", o.collimatorRadiusFraction));
   }
-  if (bad(o.gridPitch_mm, 0.0, 100.0)) return fail(fmt::format("grid plate pitch must be 0 (none) up to 100 mm, got {}", o.gridPitch_mm));
+  if (bad(o.gridPitch_mm, 0.0, 100.0)) {
+    return fail(fmt::format("grid plate pitch must be 0 (none) up to 100 mm, got {}", o.gridPitch_mm));
+  }
   if (bad(o.boneThreshold_hu, -500.0, 3000.0)) {
     return fail(fmt::format("bone threshold must be -500..3000 HU, got {}", o.boneThreshold_hu));
   }
