@@ -70,6 +70,8 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action);
 void registerTreCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct evaluate`: runs an evaluation study and writes trials.csv, report.md and charts.
 void registerEvaluateCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct dewarp-calibrate`: fits an image-intensifier dewarp from a grid plate X-ray and writes a dewarp file.
+void registerDewarpCalibrateCommand(CLI::App& app, CommandAction& action);
 
 
 }  // namespace fct::cli

@@ -31,7 +31,7 @@ constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", 
                                          "--offset",      "--gamma",            "--pincushion", "--s-distortion-deg",
                                          "--vignetting",  "--collimator",       "--kwires",     "--screws",
                                          "--plate",       "--spheres",          "--sphere-pitch-mm",
-                                         "--fixed-exposure", "--gas-pockets"};
+                                         "--fixed-exposure", "--gas-pockets", "--grid-pitch-mm"};
 /// Options that only the DRR model reads.
 constexpr const char* kDrrOnly[] = {"--method", "--i0"};
 
@@ -116,6 +116,11 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
                     "physical: a calibration grid of steel spheres near the detector, listed in views.json");
   command->add_option("--sphere-pitch-mm", p.sphereSpacing_mm, "physical: calibration grid pitch in mm")
       ->capture_default_str();
+  command->add_option("--grid-pitch-mm", p.gridPitch_mm,
+                      "physical: also write DIR/<view>_grid.png, the view's detector with only a dewarp calibration "
+                      "plate (steel beads of radius 1.5 mm at this pitch, 20 mm from the detector; no patient) through "
+                      "the same distortion, noise and blur, for 'fluoroct dewarp-calibrate'; 0 = none")
+      ->capture_default_str();
   command->callback([&action, options, command] {
     const bool physical = options->model == "physical";
     const auto firstGiven = [command](const auto& names) -> std::string {
@@ -176,6 +181,12 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
         const ViewSpec& view = simulated.value().views[n];
         fmt::print("wrote {} ({}x{}, max line integral {:.2f})\n", view.imagePath.string(),
                    view.camera.intrinsics().cols, view.camera.intrinsics().rows, simulated.value().maxLineIntegral[n]);
+      }
+      if (physical && options->physical.gridPitch_mm > 0.0) {
+        for (const ViewSpec& view : simulated.value().views) {
+          fmt::print("wrote {} (dewarp calibration grid, pitch {} mm)\n",
+                     (view.imagePath.parent_path() / (view.name + "_grid.png")).string(), options->physical.gridPitch_mm);
+        }
       }
       if (registrationCt) {
         const std::filesystem::path path = std::filesystem::path(options->out) / "ct_registration.nrrd";

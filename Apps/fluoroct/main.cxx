@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   registerRegisterCommand(app, action);
   registerTreCommand(app, action);
   registerEvaluateCommand(app, action);
+  registerDewarpCalibrateCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

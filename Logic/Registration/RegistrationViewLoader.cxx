@@ -4,8 +4,10 @@
 
 #include <string>
 
+#include "IO/Project/DewarpFile.h"
 #include "IO/Project/ViewFile.h"
 #include "IO/Xray/XrayLoader.h"
+#include "XrayPrep/XrayDewarper.h"
 
 namespace fct {
 
@@ -32,7 +34,19 @@ Result<std::vector<RegistrationView>> RegistrationViewLoader::load(const std::fi
                               viewFile.string(), spec.name, image.value().cols, image.value().rows, detector.cols,
                               detector.rows));
     }
-    views.push_back(RegistrationView{spec.name, std::move(image).value(), spec.camera, spec.calibrationSpheres});
+    RegistrationView view{spec.name, std::move(image).value(), spec.camera, spec.calibrationSpheres};
+    if (!spec.dewarpPath.empty()) {
+      auto dewarp = DewarpFile::read(spec.dewarpPath);
+      if (!dewarp) return fail(fmt::format("{}: view '{}': {}", viewFile.string(), spec.name, dewarp.error()));
+      for (const std::string& warning : dewarp.warnings()) {
+        warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
+      }
+      auto dewarped = XrayDewarper::apply(view.xray, dewarp.value().field);
+      if (!dewarped) return fail(fmt::format("{}: view '{}': {}", viewFile.string(), spec.name, dewarped.error()));
+      view.xray = std::move(dewarped).value();
+      view.spheres = XrayDewarper::mapCircles(view.spheres, dewarp.value().field);
+    }
+    views.push_back(std::move(view));
   }
   Result<std::vector<RegistrationView>> loaded(std::move(views));
   for (std::string& warning : warnings) loaded.addWarning(std::move(warning));

@@ -1,7 +1,9 @@
 #pragma once
 // RegistrationViewLoader: the views of a view file as registration takes them: the view file (ViewFile), each view's
-// X-ray (XrayLoader), checked against its camera's detector, and the view's calibration-sphere shadows. The one
-// loader of the CLI (`register --views`) and the Studio (Data step).
+// X-ray (XrayLoader), checked against its camera's detector, and the view's calibration-sphere shadows; a view that
+// names a dewarp file has its X-ray resampled onto the ideal pixel grid (XrayDewarper) and its sphere shadows moved
+// there, so that registration, the Studio's X-ray views and clicked landmarks all use ideal pixels. The one loader
+// of the CLI (`register --views`) and the Studio (Data step).
 
 #include <filesystem>
 #include <vector>
@@ -15,7 +17,8 @@ namespace fct {
 class RegistrationViewLoader {
  public:
   /// Reads the view file and every view's image, in the file's order. Fails naming the file and the view on a view
-  /// file error, a view without an image, an image that cannot be read, or an image whose size is not the detector's.
+  /// file error, a view without an image, an image that cannot be read, an image whose size is not the detector's, or
+  /// an unreadable dewarp file or one calibrated for another image size.
   /// Warnings of the view file and of the images (the latter prefixed "view '<name>': ") are on the Result.
   static Result<std::vector<RegistrationView>> load(const std::filesystem::path& viewFile);
 };

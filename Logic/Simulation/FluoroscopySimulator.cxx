@@ -23,9 +23,13 @@ namespace {
 struct Scene {
   XraySpectrum spectrum;
   std::vector<MassPaths> massAttenuation_cm2_per_g;  ///< per bin, per material
-  MaterialPathTracer tracer;
+  std::optional<MaterialPathTracer> tracer;           ///< none for a scene without patient (a grid plate image)
   ForeignObjectSet implants;  ///< CT frame
 };
+
+/// What a view shows: the patient with its implants and the calibration spheres the options ask for, or only the
+/// dewarp calibration plate (the patient out of the beam, as when the intensifier is calibrated).
+enum class ViewContent { Patient, GridPlate };
 
 /// One rendered view.
 struct RenderedView {
@@ -56,6 +60,9 @@ Status validate(const FluoroscopyOptions& o) {
   if (bad(o.collimatorRadiusFraction, 0.0, 1.5)) {
     return fail(fmt::format("collimator radius fraction must be 0 (none) or up to 1.5, got {}", o.collimatorRadiusFraction));
   }
+  if (bad(o.gridPitch_mm, 0.0, 100.0)) {
+    return fail(fmt::format("grid plate pitch must be 0 (none) up to 100 mm, got {}", o.gridPitch_mm));
+  }
   if (bad(o.boneThreshold_hu, -500.0, 3000.0)) {
     return fail(fmt::format("bone threshold must be -500..3000 HU, got {}", o.boneThreshold_hu));
   }
@@ -71,18 +78,23 @@ Status checkRigid(const Eigen::Isometry3d& T) {
   return Ok{};
 }
 
-/// Builds the spectrum, attenuation table, tracer and implants shared by every view.
-Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) {
+/// Builds the spectrum, attenuation table, tracer and implants shared by every view (no tracer or implants without
+/// a CT).
+Result<Scene> prepareScene(const Volume* ct, const FluoroscopyOptions& options) {
   if (Status valid = validate(options); !valid) return fail(valid.error());
   auto spectrum = XraySpectrum::create(spectrumOptions(options));
   if (!spectrum.ok()) return fail(spectrum.error());
-  auto tracer = MaterialPathTracer::create(ct, options.materials);
-  if (!tracer.ok()) return fail(tracer.error());
-  auto implants = ForeignObjectSet::placeNearBone(
-      ct, {options.kwireCount, options.screwCount, options.plate, options.gasPocketCount, options.boneThreshold_hu,
-           options.seed});
-  if (!implants.ok()) return fail(implants.error());
-  Scene scene{std::move(spectrum).value(), {}, std::move(tracer).value(), std::move(implants).value()};
+  Scene scene{std::move(spectrum).value(), {}, std::nullopt, ForeignObjectSet()};
+  if (ct) {
+    auto tracer = MaterialPathTracer::create(*ct, options.materials);
+    if (!tracer.ok()) return fail(tracer.error());
+    auto implants = ForeignObjectSet::placeNearBone(
+        *ct, {options.kwireCount, options.screwCount, options.plate, options.gasPocketCount, options.boneThreshold_hu,
+              options.seed});
+    if (!implants.ok()) return fail(implants.error());
+    scene.tracer = std::move(tracer).value();
+    scene.implants = std::move(implants).value();
+  }
   for (const SpectrumBin& bin : scene.spectrum.bins()) {
     MassPaths mu{};
     for (int m = 0; m < kMaterialCount; ++m) {
@@ -161,8 +173,14 @@ Result<std::optional<IntensifierDistortion>> distortionFor(const CameraIntrinsic
   return std::optional<IntensifierDistortion>(std::move(created).value());
 }
 
-/// The calibration-grid spheres of `camera` (camera frame); an empty set when the options have none.
-Result<ForeignObjectSet> calibrationSpheresFor(const Camera& camera, const FluoroscopyOptions& options) {
+/// The objects fixed to the C-arm of `camera` (camera frame): for the patient, the calibration-grid spheres (an
+/// empty set when the options have none); for a grid plate image, the plate's beads.
+Result<ForeignObjectSet> detectorObjectsFor(const Camera& camera, const FluoroscopyOptions& options,
+                                            ViewContent content) {
+  if (content == ViewContent::GridPlate) {
+    return ForeignObjectSet::calibrationGrid(camera, options.gridPitch_mm, options.gridBeadRadius_mm,
+                                             options.gridDistanceFromDetector_mm);
+  }
   if (!options.calibrationSpheres) return ForeignObjectSet();
   return ForeignObjectSet::calibrationGrid(camera, options.sphereSpacing_mm, options.sphereRadius_mm,
                                            options.sphereDistanceFromDetector_mm);
@@ -174,10 +192,12 @@ struct LineIntegrals {
   std::vector<std::uint8_t> exposed;
 };
 
-/// Pass 1: exact material path integrals through the CT, the implants and the spheres for every pixel inside the
-/// collimator, with their noiseless signal written to `image` (pixels outside stay 0).
+/// Pass 1: exact material path integrals through the CT and the implants (for the patient, when the scene has them)
+/// and the detector-fixed spheres for every pixel inside the collimator, with their noiseless signal written to
+/// `image` (pixels outside stay 0).
 LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, const ForeignObjectSet& spheres,
-                                 const SpectrumWeights& weights, FloatImage& image) {
+                                 const SpectrumWeights& weights, ViewContent content, FloatImage& image) {
+  const bool patient = content == ViewContent::Patient;
   const std::size_t pixelCount = static_cast<std::size_t>(g.in.cols) * g.in.rows;
   LineIntegrals rays{std::vector<MassPaths>(pixelCount), std::vector<std::uint8_t>(pixelCount, 0)};
   tbb::parallel_for(0, g.in.rows, [&](int row) {
@@ -189,8 +209,8 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
           Eigen::Vector3d((col - g.K(0, 2)) / g.K(0, 0), (row - g.K(1, 2)) / g.K(1, 1), 1.0).normalized();
       const Eigen::Vector3d direction_ct = g.R_ct_from_camera * direction_camera;
       MassPaths& paths = rays.pixelPaths[index];
-      paths = scene.tracer.trace(g.source_ct, direction_ct);
-      scene.implants.accumulate(g.source_ct, direction_ct, paths);
+      if (patient && scene.tracer) paths = scene.tracer->trace(g.source_ct, direction_ct);
+      if (patient) scene.implants.accumulate(g.source_ct, direction_ct, paths);
       spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
       for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
       image.pixels[index] = static_cast<float>(noiselessSignal(scene, weights, paths, transmission));
@@ -306,20 +326,22 @@ std::vector<PixelCircle> sphereShadows(const ForeignObjectSet& spheres, const Vi
 }
 
 /// Renders one view of a prepared scene; the pose must already be checked rigid. Fails on an empty detector, bad
-/// distortion or sphere settings, a collimator or pose that lets no X-ray through, or an image-processing error.
+/// distortion, sphere or plate settings, a collimator or pose that lets no X-ray through, or an image-processing
+/// error.
 Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
-                                const FluoroscopyOptions& options, std::uint32_t viewSeed) {
+                                const FluoroscopyOptions& options, std::uint32_t viewSeed,
+                                ViewContent content = ViewContent::Patient) {
   const ViewGeometry geometry = viewGeometry(camera, T_world_from_ct, options);
   if (geometry.in.cols <= 0 || geometry.in.rows <= 0) return fail("camera has an empty detector; check the view file");
   auto distortion = distortionFor(geometry.in, options);
   if (!distortion.ok()) return fail(distortion.error());
-  auto spheres = calibrationSpheresFor(camera, options);
+  auto spheres = detectorObjectsFor(camera, options, content);
   if (!spheres.ok()) return fail(spheres.error());
   const SpectrumWeights weights = spectrumWeights(scene.spectrum);
 
   RenderedView view;
   view.image = FloatImage::filled(geometry.in.cols, geometry.in.rows);
-  const LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, view.image);
+  const LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, content, view.image);
   if (Status exposure = measureExposure(rays.exposed, options, view); !exposure) return fail(exposure.error());
   exposeWithQuantumNoise(scene, weights, rays, options, viewSeed, view.referenceSignal, view.image);
   if (Status blurred = blurPointSpread(options.psfSigma_px, view.image); !blurred) return fail(blurred.error());
@@ -360,6 +382,9 @@ nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
   j["sphere_spacing_mm"] = o.sphereSpacing_mm;
   j["sphere_radius_mm"] = o.sphereRadius_mm;
   j["sphere_distance_from_detector_mm"] = o.sphereDistanceFromDetector_mm;
+  j["grid_pitch_mm"] = o.gridPitch_mm;
+  j["grid_bead_radius_mm"] = o.gridBeadRadius_mm;
+  j["grid_distance_from_detector_mm"] = o.gridDistanceFromDetector_mm;
   j["bone_threshold_hu"] = o.boneThreshold_hu;
   j["seed"] = o.seed;
   return j;
@@ -371,9 +396,21 @@ Result<FloatImage> FluoroscopySimulator::render(const Volume& ct, const Camera& 
                                                 const Eigen::Isometry3d& T_world_from_ct,
                                                 const FluoroscopyOptions& options, std::uint32_t viewSeed) {
   if (Status rigid = checkRigid(T_world_from_ct); !rigid) return fail(rigid.error());
-  auto scene = prepareScene(ct, options);
+  auto scene = prepareScene(&ct, options);
   if (!scene.ok()) return fail(scene.error());
   auto view = renderView(scene.value(), camera, T_world_from_ct, options, viewSeed);
+  if (!view.ok()) return fail(view.error());
+  return std::move(view.value().image);
+}
+
+Result<FloatImage> FluoroscopySimulator::renderGridPlate(const Camera& camera, const FluoroscopyOptions& options,
+                                                         std::uint32_t viewSeed) {
+  if (!(options.gridPitch_mm > 0.0)) {
+    return fail(fmt::format("a grid plate image needs a positive grid pitch, got {} mm", options.gridPitch_mm));
+  }
+  auto scene = prepareScene(nullptr, options);
+  if (!scene.ok()) return fail(scene.error());
+  auto view = renderView(scene.value(), camera, Eigen::Isometry3d::Identity(), options, viewSeed, ViewContent::GridPlate);
   if (!view.ok()) return fail(view.error());
   return std::move(view.value().image);
 }
@@ -385,7 +422,7 @@ Result<SimulatedCase> FluoroscopySimulator::writeCase(const Volume& ct, const st
   if (Status checked = SimulatedCaseWriter::checkViews(views); !checked) return fail(checked.error());
   if (Status rigid = checkRigid(T_world_from_ct); !rigid) return fail(rigid.error());
   if (outDir.empty()) return fail("output folder is empty");
-  auto scene = prepareScene(ct, options);
+  auto scene = prepareScene(&ct, options);
   if (!scene.ok()) return fail(scene.error());
 
   // Compute every image first, so that a failure writes nothing.
@@ -410,6 +447,14 @@ Result<SimulatedCase> FluoroscopySimulator::writeCase(const Volume& ct, const st
     }
     if (options.calibrationSpheres) {
       written[n].calibrationSpheres = view.value().spheres;
+    }
+    if (options.gridPitch_mm > 0.0) {
+      const std::uint32_t gridSeed = options.seed + static_cast<std::uint32_t>(views.size() + n);
+      auto grid = renderView(scene.value(), views[n].camera, T_world_from_ct, options, gridSeed, ViewContent::GridPlate);
+      if (!grid.ok()) return fail(fmt::format("view '{}': grid plate image: {}", views[n].name, grid.error()));
+      const std::string gridFile = views[n].name + "_grid.png";
+      extras.push_back({gridFile, std::move(grid.value().image), views[n].camera.intrinsics().pixelSpacing_mm});
+      entry["grid_image"] = {{"file", gridFile}, {"seed", gridSeed}, {"beads", grid.value().spheres.size()}};
     }
     perView.push_back(std::move(entry));
     maxLineIntegral.push_back(view.value().maxLineIntegral);

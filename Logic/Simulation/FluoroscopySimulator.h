@@ -66,6 +66,10 @@ struct FluoroscopyOptions {
   double sphereSpacing_mm = 40.0;     ///< grid pitch of the spheres
   double sphereRadius_mm = 1.5;       ///< sphere radius
   double sphereDistanceFromDetector_mm = 150.0;  ///< distance of the sphere grid plane from the detector
+  // A dewarp calibration plate: steel beads on a square grid in a plane parallel to the detector.
+  double gridPitch_mm = 0.0;          ///< > 0: writeCase also writes a grid plate image per view (see writeCase); 0..100
+  double gridBeadRadius_mm = 1.5;     ///< bead radius, below half the pitch
+  double gridDistanceFromDetector_mm = 20.0;  ///< distance of the plate from the detector
   double boneThreshold_hu = 300.0;    ///< voxels at or above are bone when placing objects
   std::uint32_t seed = 1;             ///< object placement; writeCase uses seed + n as view n's noise seed
 };
@@ -80,11 +84,19 @@ class FluoroscopySimulator {
   static Result<FloatImage> render(const Volume& ct, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
                                    const FluoroscopyOptions& options, std::uint32_t viewSeed);
 
+  /// Image of the dewarp calibration plate alone (no patient, no calibration spheres; beads of
+  /// options.gridBeadRadius_mm at options.gridPitch_mm, centred on the principal ray) seen by `camera` through the
+  /// same beam, noise (viewSeed), blur, intensifier distortion and detector response as render(). Fails on a
+  /// non-positive pitch, bad options or plate settings.
+  static Result<FloatImage> renderGridPlate(const Camera& camera, const FluoroscopyOptions& options,
+                                            std::uint32_t viewSeed);
+
   /// Renders every view (view n with noise seed options.seed + n; the same objects in every view) and writes in
   /// `outDir` (created if missing): <view>.png (16-bit), views.json (with the calibration spheres' shadows as
   /// calibration_spheres_px when spheres are on), truth_pose.json, simulation.json (every parameter, the spectrum,
   /// the µ/ρ used, the objects, `ctSource`) and, with distortion, <view>_distortion_dcol.nrrd / _drow.nrrd (per
-  /// ideal pixel, observed − ideal position in px; see IntensifierDistortion::dewarp). All images are computed
+  /// ideal pixel, observed − ideal position in px; see IntensifierDistortion::dewarp); with gridPitch_mm > 0,
+  /// <view>_grid.png, renderGridPlate() of the view (noise seed options.seed + view count + n). All images are computed
   /// before anything is written. Fails as render() does, on an empty view list or unusable view names, or an
   /// unwritable folder.
   static Result<SimulatedCase> writeCase(const Volume& ct, const std::vector<ViewSpec>& views,

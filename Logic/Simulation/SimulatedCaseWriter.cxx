@@ -55,12 +55,15 @@ Result<SimulatedCase> SimulatedCaseWriter::write(const std::vector<ViewSpec>& vi
   for (std::size_t n = 0; n < views.size(); ++n) {
     result.views[n].imagePath = dir / (views[n].name + ".png");
     result.views[n].frame = 0;
+    result.views[n].dewarpPath.clear();  // the simulated images are not from the input views' intensifier
     if (Status written = ImageFileWriter::writePng16(images[n], result.views[n].imagePath, 0.0f, 65535.0f); !written) {
       return fail(written.error());
     }
   }
   for (const SimulatedExtraImage& extra : extraImages) {
-    if (Status written = ImageFileWriter::writeNrrd2d(extra.image, dir / extra.fileName, extra.pixelSpacing_mm);
+    const std::filesystem::path path = dir / extra.fileName;
+    if (Status written = path.extension() == ".png" ? ImageFileWriter::writePng16(extra.image, path, 0.0f, 65535.0f)
+                                                    : ImageFileWriter::writeNrrd2d(extra.image, path, extra.pixelSpacing_mm);
         !written) {
       return fail(written.error());
     }

@@ -24,9 +24,10 @@ struct SimulatedCase {
   std::vector<double> maxLineIntegral;   ///< per view: the largest line integral p = -ln(I / I0) of its noiseless image
 };
 
-/// An extra 2D float image written as NRRD into the case folder (e.g. a view's distortion field).
+/// An extra 2D float image written into the case folder: float NRRD (e.g. a view's distortion field), or a 16-bit PNG
+/// like the views' when the name ends in .png (e.g. a grid plate image).
 struct SimulatedExtraImage {
-  std::string fileName;                                   ///< file name inside the case folder, ending in .nrrd
+  std::string fileName;                                   ///< file name inside the case folder, ending in .nrrd or .png
   FloatImage image;                                       ///< the values
   Eigen::Vector2d pixelSpacing_mm{1.0, 1.0};              ///< written as the NRRD spacings
 };
@@ -39,7 +40,8 @@ class SimulatedCaseWriter {
   static Status checkViews(const std::vector<ViewSpec>& views);
 
   /// Writes into `outDir` (created if missing): <view>.png (16-bit, the image's values rounded and clamped to
-  /// 0..65535, MONOCHROME2), the extra images, views.json (the views with their image paths), truth_pose.json
+  /// 0..65535, MONOCHROME2), the extra images, views.json (the views with their image paths and without any input
+  /// view's dewarp file, which does not describe simulated images), truth_pose.json
   /// (T_world_from_ct) and simulation.json (`parameters` after the keys views, pose and T_world_from_ct). Returns
   /// the written case with maxLineIntegral empty (the caller fills it). Fails on a view/image count mismatch, bad
   /// view names, or an unwritable folder or file.

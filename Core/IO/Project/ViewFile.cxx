@@ -45,6 +45,21 @@ void readImage(JsonReader& reader, const std::filesystem::path& folder, ViewSpec
   }
 }
 
+/// The dewarp file path of a view ("dewarp": "intensifier.dewarp.json"), made absolute against `folder`; checks that
+/// the file exists.
+void readDewarp(JsonReader& reader, const std::filesystem::path& folder, ViewSpec& view) {
+  if (!reader.has("dewarp")) return;
+  const std::string relative = reader.string("dewarp");
+  if (!reader.ok()) return;
+  view.dewarpPath = (folder / std::filesystem::path(relative)).lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(view.dewarpPath, ec)) {
+    reader.rejectKey("dewarp", fmt::format("names '{}', which does not exist; make it with 'fluoroct dewarp-calibrate' "
+                                           "(paths are relative to the view file's folder '{}')",
+                                           view.dewarpPath.string(), folder.string()));
+  }
+}
+
 /// The camera from either T_world_from_camera + source_to_detector_mm + principal_point_px, or projection_matrix.
 void readCamera(JsonReader& reader, ViewSpec& view) {
   CameraIntrinsics intrinsics;
@@ -142,12 +157,13 @@ Result<std::vector<ViewSpec>> ViewFile::read(const std::filesystem::path& path) 
     }
     JsonReader reader(viewJson, fmt::format("{}: view '{}'", file, view.name));
     readImage(reader, folder, view, warnings);
+    readDewarp(reader, folder, view);
     readCamera(reader, view);
     readSpheres(reader, view, warnings);
     if (!reader.ok()) return fail(reader.error());
     addWarnings(warnings, reader.unknownKeys({"name", "image", "detector", "source_to_detector_mm",
                                               "principal_point_px", "T_world_from_camera", "projection_matrix",
-                                              "calibration_spheres_px"}));
+                                              "calibration_spheres_px", "dewarp"}));
     addWarnings(warnings, reader.unknownKeys({"cols", "rows", "pixel_spacing_mm"}, "detector"));
     views.push_back(std::move(view));
   }
@@ -175,6 +191,7 @@ Status ViewFile::write(const std::vector<ViewSpec>& views, const std::filesystem
     if (!view.imagePath.empty()) {
       v["image"] = ordered_json{{"path", pathForFile(view.imagePath, folder)}, {"frame", view.frame}};
     }
+    if (!view.dewarpPath.empty()) v["dewarp"] = pathForFile(view.dewarpPath, folder);
     v["detector"] = ordered_json{{"cols", in.cols},
                                  {"rows", in.rows},
                                  {"pixel_spacing_mm", JsonDocument::array(in.pixelSpacing_mm)}};

@@ -20,6 +20,7 @@ struct ViewSpec {
   int frame = 0;                    ///< frame of a multi-frame image file
   Camera camera;
   std::vector<PixelCircle> calibrationSpheres;  ///< shadows of calibration-grid spheres, masked out of the comparison
+  std::filesystem::path dewarpPath;  ///< the view's dewarp file (DewarpFile); empty if none; absolute after read
 };
 
 /// Reads and writes view files.

@@ -1,10 +1,13 @@
 // RegistrationViewLoader: a view file with its PNG images becomes registration views; a view without an image, an
-// unreadable image and an image of the wrong size are refused naming the file and the view.
+// unreadable image and an image of the wrong size are refused naming the file and the view; a view's dewarp file
+// resamples its image and moves its spheres.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "Base/JsonDocument.h"
+#include "IO/Project/DewarpFile.h"
 #include "IO/Project/ViewFile.h"
 #include "IO/Xray/ImageFileWriter.h"
 #include "Registration/RegistrationViewLoader.h"
@@ -28,8 +31,8 @@ void writeImage(const fs::path& path, int cols, int rows) {
 
 /// Two views "ap" and "lat" (48 x 32 detectors); "lat" has a calibration sphere.
 std::vector<fct::ViewSpec> twoViews(const fs::path& dir) {
-  fct::ViewSpec ap{"ap", dir / "ap.png", 0, camera(48, 32, 0.0), {}};
-  fct::ViewSpec lat{"lat", dir / "lat.png", 0, camera(48, 32, 1.5707963), {{{10.5, 12.0}, 3.0}}};
+  fct::ViewSpec ap{"ap", dir / "ap.png", 0, camera(48, 32, 0.0), {}, {}};
+  fct::ViewSpec lat{"lat", dir / "lat.png", 0, camera(48, 32, 1.5707963), {{{10.5, 12.0}, 3.0}}, {}};
   return {ap, lat};
 }
 
@@ -105,4 +108,62 @@ TEST(RegistrationViewLoader, PassesOnViewFileErrorsAndWarnings) {
   ASSERT_TRUE(noted.ok()) << noted.error();
   ASSERT_EQ(noted.warnings().size(), 1u);
   EXPECT_NE(noted.warnings()[0].find("'note'"), std::string::npos) << noted.warnings()[0];
+}
+
+namespace {
+
+/// A degree-3 dewarp of a 48 x 32 detector that moves pixels towards the centre by 0.05 R rho^2.
+fct::DewarpFileContents barrelCorrection(int cols, int rows) {
+  const auto terms = fct::DewarpField::terms(3);
+  Eigen::VectorXd col = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(terms.size())), row = col;
+  for (std::size_t t = 0; t < terms.size(); ++t) {
+    const auto i = static_cast<Eigen::Index>(t);
+    if (terms[t] == std::array<int, 2>{3, 0} || terms[t] == std::array<int, 2>{1, 2}) col[i] = -0.05;
+    if (terms[t] == std::array<int, 2>{0, 3} || terms[t] == std::array<int, 2>{2, 1}) row[i] = -0.05;
+  }
+  return {fct::DewarpField::create(cols, rows, 3, col, row).value(), {}};
+}
+
+}  // namespace
+
+TEST(RegistrationViewLoader, AViewsDewarpResamplesItsImageAndMovesItsSpheres) {
+  const fs::path dir = fct::test::scratchDir();
+  writeImage(dir / "ap.png", 48, 32);
+  writeImage(dir / "lat.png", 48, 32);
+  const fct::DewarpFileContents dewarp = barrelCorrection(48, 32);
+  ASSERT_TRUE(fct::DewarpFile::write(dewarp, dir / "ii.dewarp.json").ok());
+  std::vector<fct::ViewSpec> specs = twoViews(dir);
+  specs[1].dewarpPath = dir / "ii.dewarp.json";
+  ASSERT_TRUE(fct::ViewFile::write(specs, dir / "views.json").ok());
+  auto views = fct::RegistrationViewLoader::load(dir / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  EXPECT_TRUE(views.value()[0].xray.fovMask.empty());
+  const fct::XrayImage& lat = views.value()[1].xray;
+  ASSERT_EQ(lat.fovMask.size(), 48u * 32u);
+  // Ideal pixel u shows the stored pixel d(u); the stored image is i % 97 / 97, read back from 16-bit PNG (x 65535).
+  const Eigen::Vector2d u(40.0, 5.0);
+  const Eigen::Vector2d d = dewarp.field.distorted(u).value();
+  ASSERT_GT((d - u).norm(), 0.5);
+  const auto stored = [&](int c, int r) { return std::round(65535.0f * static_cast<float>((r * 48 + c) % 97) / 97.0f); };
+  const int c0 = static_cast<int>(d.x()), r0 = static_cast<int>(d.y());
+  const float fc = static_cast<float>(d.x() - c0), fr = static_cast<float>(d.y() - r0);
+  const float expected = (1 - fr) * ((1 - fc) * stored(c0, r0) + fc * stored(c0 + 1, r0)) +
+                         fr * ((1 - fc) * stored(c0, r0 + 1) + fc * stored(c0 + 1, r0 + 1));
+  EXPECT_NEAR(lat.at(40, 5), expected, 0.5);
+  ASSERT_EQ(views.value()[1].spheres.size(), 1u);
+  EXPECT_LT((views.value()[1].spheres[0].centre_px - dewarp.field.ideal(Eigen::Vector2d(10.5, 12.0))).norm(), 1e-12);
+}
+
+TEST(RegistrationViewLoader, RefusesADewarpCalibratedForAnotherImageSize) {
+  const fs::path dir = fct::test::scratchDir();
+  writeImage(dir / "ap.png", 48, 32);
+  writeImage(dir / "lat.png", 48, 32);
+  ASSERT_TRUE(fct::DewarpFile::write(barrelCorrection(64, 48), dir / "ii.dewarp.json").ok());
+  std::vector<fct::ViewSpec> specs = twoViews(dir);
+  specs[0].dewarpPath = dir / "ii.dewarp.json";
+  ASSERT_TRUE(fct::ViewFile::write(specs, dir / "views.json").ok());
+  auto views = fct::RegistrationViewLoader::load(dir / "views.json");
+  ASSERT_FALSE(views.ok());
+  EXPECT_NE(views.error().find("view 'ap'"), std::string::npos) << views.error();
+  EXPECT_NE(views.error().find("calibrated for 64x48"), std::string::npos) << views.error();
 }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -245,6 +246,38 @@ TEST(FluoroscopySimulator, WritesACaseWithSpheresDistortionFieldAndParameters) {
   EXPECT_NE(text.find("\"model\": \"physical\""), std::string::npos);
   EXPECT_NE(text.find("\"kind\": \"kwire\""), std::string::npos);
   EXPECT_NE(text.find("\"pincushion\": 0.03"), std::string::npos);
+}
+
+TEST(FluoroscopySimulator, WritesAGridPlateImagePerViewAndNoInputDewarpFile) {
+  const fct::Volume ct = smallPhantom();
+  fct::StandardViewOptions viewOptions;
+  viewOptions.count = 2;
+  viewOptions.cols = 120;
+  viewOptions.rows = 90;
+  viewOptions.pixelSpacing_mm = 1.0;
+  auto views = fct::StandardViews::build(Eigen::Vector3d::Zero(), viewOptions).value();
+  views[0].dewarpPath = fct::test::scratchDir() / "other_intensifier.dewarp.json";
+  fct::FluoroscopyOptions options;
+  options.pincushion = 0.03;
+  options.gridPitch_mm = 10.0;
+  const auto dir = fct::test::scratchDir() / "case";
+  auto simulated = fct::FluoroscopySimulator::writeCase(ct, views, Eigen::Isometry3d::Identity(), options, dir, "phantom");
+  ASSERT_TRUE(simulated.ok()) << simulated.error();
+  for (const auto& view : views) EXPECT_TRUE(std::filesystem::exists(dir / (view.name + "_grid.png"))) << view.name;
+  const auto written = fct::ViewFile::read(dir / "views.json");
+  ASSERT_TRUE(written.ok()) << written.error();
+  EXPECT_TRUE(written.value()[0].dewarpPath.empty());
+  // The plate alone, rendered without a CT: its steel beads are dark spots; a zero pitch is refused.
+  auto plate = fct::FluoroscopySimulator::renderGridPlate(views[1].camera, options, 1);
+  ASSERT_TRUE(plate.ok()) << plate.error();
+  float darkest = plate.value().pixels[0], brightest = darkest;
+  for (float v : plate.value().pixels) {
+    darkest = std::min(darkest, v);
+    brightest = std::max(brightest, v);
+  }
+  EXPECT_LT(darkest, 0.8f * brightest) << "the beads show";
+  options.gridPitch_mm = 0.0;
+  EXPECT_FALSE(fct::FluoroscopySimulator::renderGridPlate(views[1].camera, options, 1).ok());
 }
 
 TEST(FluoroscopySimulator, RejectsBadInput) {

@@ -268,3 +268,29 @@ TEST(ViewFile, WriteFailsOnUnwritablePathOrDuplicateNamesAndWritesNothing) {
   EXPECT_FALSE(fct::ViewFile::write({}, dir / "views.json").ok());
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
+
+TEST(ViewFile, DewarpPathIsRelativeToTheViewFileAndRoundTrips) {
+  const auto dir = fct::test::scratchDir();
+  touch(dir / "sub" / "calibration" / "ii.dewarp.json");
+  json view = validView("AP");
+  view["dewarp"] = "calibration/ii.dewarp.json";
+  const auto path = dir / "sub" / "views.json";
+  ASSERT_TRUE(fct::TextFile::writeAtomically(path, json{{"views", {view}}}.dump()).ok());
+  const auto read = fct::ViewFile::read(path);
+  ASSERT_TRUE(read.ok()) << read.error();
+  EXPECT_TRUE(read.warnings().empty());
+  const auto expected = std::filesystem::absolute(dir / "sub" / "calibration" / "ii.dewarp.json").lexically_normal();
+  EXPECT_EQ(read.value()[0].dewarpPath, expected);
+  ASSERT_TRUE(fct::ViewFile::write(read.value(), path).ok());
+  const json written = json::parse(fct::TextFile::read(path).value());
+  EXPECT_EQ(written["views"][0]["dewarp"], "calibration/ii.dewarp.json");
+  EXPECT_EQ(fct::ViewFile::read(path).value()[0].dewarpPath, expected);
+}
+
+TEST(ViewFile, RejectsAMissingDewarpFileNamingTheCommandThatMakesIt) {
+  json view = validView("AP");
+  view["dewarp"] = "missing.dewarp.json";
+  const std::string error = readError(json{{"views", {view}}});
+  EXPECT_NE(error.find("view 'AP': key 'dewarp'"), std::string::npos) << error;
+  EXPECT_NE(error.find("dewarp-calibrate"), std::string::npos) << error;
+}
