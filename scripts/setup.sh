@@ -10,7 +10,7 @@ FCT_PACKAGES=(
   cmake ninja-build ccache g++ pkg-config
   qt6-base-dev libqt6opengl6-dev libxkbcommon-dev libgl-dev libvtk9-dev libeigen3-dev libopencv-dev libdcmtk-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev libfmt-dev libtbb-dev libcli11-dev zlib1g-dev
-  xvfb xauth plastimatch
+  xvfb xauth plastimatch dicom3tools
 )
 
 fct_install_packages() {

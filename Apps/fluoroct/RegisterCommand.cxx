@@ -1,5 +1,5 @@
 // fluoroct register: registers a CT to the X-ray views of a view file (Registration, a preset schedule) from an
-// initial pose given as a pose file or estimated from landmarks; writes RESULT.json.
+// initial pose given as a pose file or estimated from landmarks; writes RESULT.json (and a DICOM REG object).
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -16,10 +16,12 @@
 #include "CliSupport.h"
 #include "Evaluation/ContourOverlay.h"
 #include "InitialPose/LandmarkPoseEstimator.h"
+#include "IO/Dicom/DicomRegistrationWriter.h"
 #include "IO/Project/LandmarkPairFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
+#include "IO/Xray/XrayLoader.h"
 #include "Registration/Registration.h"
 #include "Registration/RegistrationResultJson.h"
 #include "Registration/RegistrationViewLoader.h"
@@ -48,6 +50,7 @@ struct Options {
   bool noMetalMask = false;
   double metalMinExcess = MetalMaskOptions{}.minExcess;
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
+  std::string dicomReg;  ///< optional DICOM Spatial Registration object (REG) of the final pose
   RegistrationAblation ablation;
 };
 
@@ -351,6 +354,25 @@ void printResult(const Options& o, const RegistrationResult& r, const std::optio
   }
 }
 
+/// --dicom-reg: the final pose as a DICOM Spatial Registration object referring to the CT and the DICOM X-rays.
+Status writeDicomRegistration(const Options& o, const Inputs& in, const RegistrationResult& r) {
+  std::vector<fs::path> xrayDicomFiles;
+  for (const RegistrationView& view : in.views) {
+    if (!XrayLoader::isPlainImageFile(view.xray.sourcePath)) xrayDicomFiles.emplace_back(view.xray.sourcePath);
+  }
+  auto registration = DicomRegistrationWriter::describe(in.ct, r.T_world_from_ct, xrayDicomFiles);
+  if (!registration) return fail("--dicom-reg: " + registration.error());
+  printWarnings(registration.warnings());
+  const double similarity = r.stages.empty() ? 0.0 : r.stages.back().similarity;
+  registration.value().contentDescription =
+      fmt::format("FluoroCT bone pose T_world_from_ct{}, final similarity {:.4f}",
+                  r.cancelled ? " (cancelled: best pose so far)" : "", similarity);
+  if (Status written = DicomRegistrationWriter::write(registration.value(), o.dicomReg); !written) {
+    return fail("--dicom-reg: " + written.error());
+  }
+  return Ok{};
+}
+
 int runRegister(const Options& o) {
   auto inputs = readInputs(o);
   if (!inputs) return reportError(inputs.error());
@@ -375,7 +397,11 @@ int runRegister(const Options& o) {
         JsonDocument::write(resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal), error), o.out);
     if (!written) return reportError(written.error());
   }
+  if (!o.dicomReg.empty()) {
+    if (Status written = writeDicomRegistration(o, in, r); !written) return reportError(written.error());
+  }
   printResult(o, r, error);
+  if (!o.dicomReg.empty()) fmt::print("wrote DICOM registration {}\n", o.dicomReg);
   return 0;
 }
 
@@ -411,6 +437,9 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       ->check(positiveNumber())
       ->capture_default_str();
   command->add_option("--out", options->out, "Result JSON file (written atomically)");
+  command->add_option("--dicom-reg", options->dicomReg,
+                      "Also write the final pose as a DICOM Spatial Registration object (REG, .dcm) referring to the "
+                      "CT series and the DICOM X-rays (written atomically)");
   command->add_option("--truth", options->truth,
                       "Known true pose file (simulated cases): report the mean/max bone-surface distance to it");
   command->add_option("--overlays", options->overlays,

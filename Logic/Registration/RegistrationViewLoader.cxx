@@ -2,12 +2,28 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <string>
 
 #include "IO/Project/ViewFile.h"
 #include "IO/Xray/XrayLoader.h"
 
 namespace fct {
+
+namespace {
+
+/// Flips an image left-right in place (column c <-> cols-1-c), with its field-of-view mask; drops its own camera,
+/// which belonged to the unflipped pixels.
+void mirrorColumns(XrayImage& image) {
+  for (int row = 0; row < image.rows; ++row) {
+    const auto begin = static_cast<std::ptrdiff_t>(row) * image.cols;
+    std::reverse(image.pixels.begin() + begin, image.pixels.begin() + begin + image.cols);
+    if (!image.fovMask.empty()) std::reverse(image.fovMask.begin() + begin, image.fovMask.begin() + begin + image.cols);
+  }
+  image.camera.reset();
+}
+
+}  // namespace
 
 Result<std::vector<RegistrationView>> RegistrationViewLoader::load(const std::filesystem::path& viewFile) {
   auto specs = ViewFile::read(viewFile);
@@ -25,6 +41,7 @@ Result<std::vector<RegistrationView>> RegistrationViewLoader::load(const std::fi
     for (const std::string& warning : image.warnings()) {
       warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
     }
+    if (spec.mirrorColumns) mirrorColumns(image.value());
     const CameraIntrinsics& detector = spec.camera.intrinsics();
     if (image.value().cols != detector.cols || image.value().rows != detector.rows) {
       return fail(fmt::format("{}: view '{}': the image is {}x{} pixels but the detector is {}x{}; fix the view "

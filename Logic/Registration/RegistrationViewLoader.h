@@ -14,7 +14,8 @@ namespace fct {
 /// Loads registration views.
 class RegistrationViewLoader {
  public:
-  /// Reads the view file and every view's image, in the file's order. Fails naming the file and the view on a view
+  /// Reads the view file and every view's image, in the file's order (flipped left-right when the view says
+  /// mirror_columns). Fails naming the file and the view on a view
   /// file error, a view without an image, an image that cannot be read, or an image whose size is not the detector's.
   /// Warnings of the view file and of the images (the latter prefixed "view '<name>': ") are on the Result.
   static Result<std::vector<RegistrationView>> load(const std::filesystem::path& viewFile);
