@@ -16,13 +16,12 @@
 #include "CliSupport.h"
 #include "Evaluation/ContourOverlay.h"
 #include "InitialPose/LandmarkPoseEstimator.h"
-#include "IO/Dicom/DicomRegistrationWriter.h"
 #include "IO/Project/LandmarkPairFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
-#include "IO/Xray/XrayLoader.h"
 #include "Registration/Registration.h"
+#include "Registration/RegistrationDicomExport.h"
 #include "Registration/RegistrationResultJson.h"
 #include "Registration/RegistrationViewLoader.h"
 
@@ -354,25 +353,6 @@ void printResult(const Options& o, const RegistrationResult& r, const std::optio
   }
 }
 
-/// --dicom-reg: the final pose as a DICOM Spatial Registration object referring to the CT and the DICOM X-rays.
-Status writeDicomRegistration(const Options& o, const Inputs& in, const RegistrationResult& r) {
-  std::vector<fs::path> xrayDicomFiles;
-  for (const RegistrationView& view : in.views) {
-    if (!XrayLoader::isPlainImageFile(view.xray.sourcePath)) xrayDicomFiles.emplace_back(view.xray.sourcePath);
-  }
-  auto registration = DicomRegistrationWriter::describe(in.ct, r.T_world_from_ct, xrayDicomFiles);
-  if (!registration) return fail("--dicom-reg: " + registration.error());
-  printWarnings(registration.warnings());
-  const double similarity = r.stages.empty() ? 0.0 : r.stages.back().similarity;
-  registration.value().contentDescription =
-      fmt::format("FluoroCT bone pose T_world_from_ct{}, final similarity {:.4f}",
-                  r.cancelled ? " (cancelled: best pose so far)" : "", similarity);
-  if (Status written = DicomRegistrationWriter::write(registration.value(), o.dicomReg); !written) {
-    return fail("--dicom-reg: " + written.error());
-  }
-  return Ok{};
-}
-
 int runRegister(const Options& o) {
   auto inputs = readInputs(o);
   if (!inputs) return reportError(inputs.error());
@@ -398,7 +378,9 @@ int runRegister(const Options& o) {
     if (!written) return reportError(written.error());
   }
   if (!o.dicomReg.empty()) {
-    if (Status written = writeDicomRegistration(o, in, r); !written) return reportError(written.error());
+    auto written = RegistrationDicomExport::write(in.ct, in.views, r, o.dicomReg);
+    if (!written) return reportError("--dicom-reg: " + written.error());
+    printWarnings(written.warnings());
   }
   printResult(o, r, error);
   if (!o.dicomReg.empty()) fmt::print("wrote DICOM registration {}\n", o.dicomReg);

@@ -25,31 +25,38 @@ void mirrorColumns(XrayImage& image) {
 
 }  // namespace
 
+Result<RegistrationView> RegistrationViewLoader::loadView(const ViewSpec& spec) {
+  if (spec.imagePath.empty()) {
+    return fail(fmt::format("view '{}' has no image; registration needs an X-ray per view: add the key \"image\" "
+                            "with the view's X-ray file",
+                            spec.name));
+  }
+  auto image = XrayLoader::load(spec.imagePath, spec.frame);
+  if (!image) return fail(fmt::format("view '{}': {}", spec.name, image.error()));
+  std::vector<std::string> warnings;
+  for (const std::string& warning : image.warnings()) warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
+  if (spec.mirrorColumns) mirrorColumns(image.value());
+  const CameraIntrinsics& detector = spec.camera.intrinsics();
+  if (image.value().cols != detector.cols || image.value().rows != detector.rows) {
+    return fail(fmt::format("view '{}': the image is {}x{} pixels but the detector is {}x{}; fix the view file's "
+                            "detector size or give the matching image",
+                            spec.name, image.value().cols, image.value().rows, detector.cols, detector.rows));
+  }
+  Result<RegistrationView> view(RegistrationView{spec.name, std::move(image).value(), spec.camera, spec.calibrationSpheres});
+  for (std::string& warning : warnings) view.addWarning(std::move(warning));
+  return view;
+}
+
 Result<std::vector<RegistrationView>> RegistrationViewLoader::load(const std::filesystem::path& viewFile) {
   auto specs = ViewFile::read(viewFile);
   if (!specs) return fail(specs.error());
   std::vector<std::string> warnings = specs.warnings();
   std::vector<RegistrationView> views;
   for (const ViewSpec& spec : specs.value()) {
-    if (spec.imagePath.empty()) {
-      return fail(fmt::format("{}: view '{}' has no image; registration needs an X-ray per view: add the key "
-                              "\"image\" with the view's X-ray file",
-                              viewFile.string(), spec.name));
-    }
-    auto image = XrayLoader::load(spec.imagePath, spec.frame);
-    if (!image) return fail(fmt::format("{}: view '{}': {}", viewFile.string(), spec.name, image.error()));
-    for (const std::string& warning : image.warnings()) {
-      warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
-    }
-    if (spec.mirrorColumns) mirrorColumns(image.value());
-    const CameraIntrinsics& detector = spec.camera.intrinsics();
-    if (image.value().cols != detector.cols || image.value().rows != detector.rows) {
-      return fail(fmt::format("{}: view '{}': the image is {}x{} pixels but the detector is {}x{}; fix the view "
-                              "file's detector size or give the matching image",
-                              viewFile.string(), spec.name, image.value().cols, image.value().rows, detector.cols,
-                              detector.rows));
-    }
-    views.push_back(RegistrationView{spec.name, std::move(image).value(), spec.camera, spec.calibrationSpheres});
+    auto view = loadView(spec);
+    if (!view) return fail(fmt::format("{}: {}", viewFile.string(), view.error()));
+    warnings.insert(warnings.end(), view.warnings().begin(), view.warnings().end());
+    views.push_back(std::move(view).value());
   }
   Result<std::vector<RegistrationView>> loaded(std::move(views));
   for (std::string& warning : warnings) loaded.addWarning(std::move(warning));

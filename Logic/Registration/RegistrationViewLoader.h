@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "Base/Result.h"
+#include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationView.h"
 
 namespace fct {
@@ -19,6 +20,11 @@ class RegistrationViewLoader {
   /// file error, a view without an image, an image that cannot be read, or an image whose size is not the detector's.
   /// Warnings of the view file and of the images (the latter prefixed "view '<name>': ") are on the Result.
   static Result<std::vector<RegistrationView>> load(const std::filesystem::path& viewFile);
+
+  /// One view's image (XrayLoader; flipped left-right when the view says mirror_columns) with its camera and spheres.
+  /// Fails naming the view when it has no image, the image cannot be read or its size is not the detector's; the
+  /// image's warnings are on the Result, prefixed "view '<name>': ".
+  static Result<RegistrationView> loadView(const ViewSpec& spec);
 };
 
 }  // namespace fct

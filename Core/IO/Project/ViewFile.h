@@ -18,9 +18,9 @@ struct ViewSpec {
   std::string name;
   std::filesystem::path imagePath;  ///< empty if none; absolute after read
   int frame = 0;                    ///< frame of a multi-frame image file
-  bool mirrorColumns = false;       ///< flip the image left-right on load (a DICOM stored mirrored against the camera)
   Camera camera;
   std::vector<PixelCircle> calibrationSpheres;  ///< shadows of calibration-grid spheres, masked out of the comparison
+  bool mirrorColumns = false;  ///< flip the image left-right on load (a DICOM stored mirrored against the camera)
 };
 
 /// Reads and writes view files.
