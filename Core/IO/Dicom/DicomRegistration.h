@@ -23,8 +23,8 @@ struct DicomRegistration {
   /// The registered X-ray instances (their study, series and SOP instance); empty when the views are not DICOM.
   std::vector<DicomIdentity> xrays;
   std::string contentDescription;  ///< free text, e.g. the final similarity
-  std::string sopInstanceUid;      ///< of the REG object itself (set by the writer when empty, read back by the reader)
-  std::string seriesInstanceUid;   ///< of the REG object's series (set by the writer when empty)
+  std::string sopInstanceUid;      ///< of the REG object itself (the writer generates one when empty)
+  std::string seriesInstanceUid;   ///< of the REG object's series (the writer generates one when empty)
 };
 
 }  // namespace fct

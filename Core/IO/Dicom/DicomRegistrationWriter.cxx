@@ -85,7 +85,7 @@ void putRegistrationItem(DcmItem& item, const std::string& frameOfReferenceUid, 
 
 /// Common Instance Reference module: series of the REG's study in Referenced Series, the others per study.
 void putInstanceReferences(DcmDataset& ds, const std::string& studyUid, const std::vector<DicomIdentity>& sources) {
-  // study -> series -> instances, in first-seen order of the sources
+  // study -> series -> instances, each level sorted by UID
   std::map<std::string, std::map<std::string, std::vector<DicomInstance>>> byStudy;
   for (const DicomIdentity& source : sources) {
     if (source.instances.empty() || source.seriesInstanceUid.empty()) continue;
@@ -134,8 +134,8 @@ Result<DicomRegistration> DicomRegistrationWriter::describe(const Volume& ct, co
       std::tie(registration.ct.studyDate, registration.ct.studyTime) = now();
     }
     warnings.push_back(fmt::format("the CT was not read from a DICOM series with a Frame of Reference UID; the "
-                                   "registration names it by a generated Frame of Reference UID {} (no patient or "
-                                   "study identity is copied), so a viewer cannot match it to the CT by itself",
+                                   "registration names its frame by a generated Frame of Reference UID {}, so a "
+                                   "viewer cannot match it to the CT by itself",
                                    registration.ct.frameOfReferenceUid));
   }
   std::set<std::string> xrayFrames;

@@ -7,7 +7,6 @@
 #include <dcmtk/dcmdata/dcxfer.h>
 #include <fmt/core.h>
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>

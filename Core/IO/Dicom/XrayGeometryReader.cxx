@@ -5,7 +5,6 @@
 #include <fmt/core.h>
 
 #include <Eigen/Geometry>
-#include <array>
 #include <cmath>
 #include <vector>
 
