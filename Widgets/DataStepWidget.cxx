@@ -81,8 +81,9 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   auto* viewButtons = new QHBoxLayout;
   m_openViews = new QPushButton(tr("Open view file…"), viewBox);
   m_openViews->setToolTip(tr("Read a view file (JSON) listing each X-ray with its calibrated C-arm camera"));
-  m_addXrays = new QPushButton(tr("Add X-ray files…"), viewBox);
-  m_addXrays->setToolTip(tr("Add DICOM X-rays whose C-arm geometry tags give their camera"));
+  m_addXrays = new QPushButton(tr("Views from DICOM tags…"), viewBox);
+  m_addXrays->setToolTip(tr("Pick X-ray DICOM files (XA, RF, DX, CR): one view each, its camera from the C-arm "
+                            "geometry tags (distances, pixel spacing, positioner angles, patient orientation)"));
   viewButtons->addWidget(m_openViews);
   viewButtons->addWidget(m_addXrays);
   viewLayout->addLayout(viewButtons);
@@ -135,7 +136,7 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
     if (!file.isEmpty()) openViewFile(file);
   });
   connect(m_addXrays, &QPushButton::clicked, this, [this] {
-    const QStringList files = QFileDialog::getOpenFileNames(this, tr("Add X-ray files"));
+    const QStringList files = QFileDialog::getOpenFileNames(this, tr("Views from DICOM tags: pick X-ray DICOM files"));
     if (!files.isEmpty()) addXrayFiles(files);
   });
   connect(m_openCase, &QPushButton::clicked, this, [this] {
@@ -285,16 +286,20 @@ void DataStepWidget::addXrayFiles(const QStringList& paths) {
       tr("Loading %1 X-ray file(s)…").arg(paths.size()),
       [files]() -> Views {
         std::vector<RegistrationView> views;
+        std::vector<std::string> warnings;
         for (const fs::path& file : files) {
           auto view = StudioDocument::readXrayFile(file);
           if (!view) return fail(view.error());
+          warnings.insert(warnings.end(), view.warnings().begin(), view.warnings().end());
           views.push_back(std::move(view).value());
         }
-        return views;
+        Views result(std::move(views));
+        for (std::string& warning : warnings) result.addWarning(std::move(warning));
+        return result;
       },
       [this](Views& loaded) {
         if (!loaded) return reportError(tr("Could not add the X-rays"), loaded.error());
-        const Status added = m_document->addXrayViews(loaded.value());
+        const Status added = m_document->addXrayViews(loaded.value(), loaded.warnings());
         if (!added) return reportError(tr("Could not add the X-rays"), added.error());
         reportSuccess(tr("Added %1 X-ray view(s)").arg(loaded.value().size()));
       });

@@ -1,6 +1,6 @@
 #pragma once
 // DataStepWidget: the Data step of the workflow: open a CT (DICOM folder, choosing among its series, or a volume
-// file), a view file with its X-rays, single X-ray files with their own geometry, or a whole case folder; show what
+// file), a view file with its X-rays, views from the C-arm tags of X-ray DICOM files, or a whole case folder; show what
 // was loaded and any warnings in words. Loading runs on a worker thread with a busy bar; a failure shows the message
 // in the step (and the status line) and leaves the document as it was.
 
@@ -62,7 +62,8 @@ class DataStepWidget : public QWidget {
   void chooseSeries(int index);
   /// Opens a view file and its X-rays (background; loadFinished()).
   void openViewFile(const QString& path);
-  /// Adds X-ray files that carry their own C-arm geometry as views (loadFinished()).
+  /// "Views from DICOM tags": adds one view per X-ray DICOM file, its camera from the file's C-arm geometry tags
+  /// (StudioDocument::readXrayFile), in the background (loadFinished()).
   void addXrayFiles(const QStringList& paths);
   /// Opens a case folder (findCaseFiles): CT, views and initial pose together (background; loadFinished()).
   void openCaseFolder(const QString& folder);

@@ -26,6 +26,7 @@
 #include "IO/Project/ItkTransformFile.h"
 #include "Interop/IgtlTransformSender.h"
 #include "IO/Project/PoseFile.h"
+#include "Registration/RegistrationDicomExport.h"
 #include "Widgets/StudioDocument.h"
 #include "Widgets/XrayViewWidget.h"
 
@@ -129,8 +130,12 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
 
   auto* exportRow = new QHBoxLayout();
   auto* exportButton = new QPushButton(tr("Export pose…"), this);
+  auto* dicomButton = new QPushButton(tr("Export DICOM registration…"), this);
+  dicomButton->setToolTip(tr("Write the final pose as a DICOM Spatial Registration object (REG) referring to the CT "
+                             "series and the DICOM X-rays, for a navigation system or PACS"));
   auto* screenshotButton = new QPushButton(tr("Screenshot…"), this);
   exportRow->addWidget(exportButton);
+  exportRow->addWidget(dicomButton);
   exportRow->addWidget(screenshotButton);
   layout->addLayout(exportRow);
 
@@ -195,6 +200,11 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
       showMessage(tr("Not sent to 3D Slicer: %1").arg(error), true);
     }
     emit slicerSendFinished(error.isEmpty());
+  });
+  connect(dicomButton, &QPushButton::clicked, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export DICOM registration"),
+                                                      QStringLiteral("registration.dcm"), tr("DICOM file (*.dcm)"));
+    if (!path.isEmpty()) exportDicomRegistration(path);
   });
   connect(screenshotButton, &QPushButton::clicked, this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, tr("Save screenshot"), QStringLiteral("review.png"),
@@ -517,6 +527,25 @@ void ReviewStepWidget::sendToSlicer() {
     const Status sent = sender.send(T_world_from_ct);
     return sent ? QString() : QString::fromStdString(sent.error());
   }));
+}
+
+bool ReviewStepWidget::exportDicomRegistration(const QString& path) {
+  const auto& result = m_document->result();
+  if (!result || !m_document->ct()) {
+    showMessage(tr("No registration result to export: run one in the Register step."), true);
+    return false;
+  }
+  auto written =
+      RegistrationDicomExport::write(*m_document->ct(), m_document->views(), *result, path.toStdString());
+  if (!written) {
+    showMessage(tr("Cannot export the DICOM registration: %1").arg(QString::fromStdString(written.error())), true);
+    return false;
+  }
+  QString text = tr("Exported the final pose%1 as a DICOM registration to %2.")
+                     .arg(result->cancelled ? tr(" (cancelled run)") : QString(), path);
+  for (const std::string& warning : written.warnings()) text += QStringLiteral("\n") + QString::fromStdString(warning);
+  showMessage(text, false);
+  return true;
 }
 
 bool ReviewStepWidget::saveScreenshot(const QString& path) {

@@ -4,8 +4,9 @@
 // with an opacity; the DRR at the final pose blended over the X-ray or as a checkerboard, with a flicker toggle
 // (a QTimer switching the DRR on and off). With a ground truth (simulated case) the sTRE, the mean bone-surface
 // distance to the truth (BoneSurface), is shown for both poses. Accept / Reject record the verdict in the document;
-// the final pose exports as an ITK .tfm for 3D Slicer or as pose JSON, and the X-ray views as a PNG screenshot;
-// "Send to Slicer" sends it live to 3D Slicer's OpenIGTLinkIF (host and port fields) off the GUI thread.
+// the final pose exports as an ITK .tfm for 3D Slicer, as pose JSON or as a DICOM registration (REG), and the X-ray
+// views as a PNG screenshot; "Send to Slicer" sends it live to 3D Slicer's OpenIGTLinkIF (host and port fields) off
+// the GUI thread.
 
 #include <Eigen/Core>
 #include <QColor>
@@ -88,6 +89,9 @@ class ReviewStepWidget : public QWidget {
   void rejectResult();
   /// Writes the final pose: ITK transform for a path ending in .tfm, else pose JSON. False with the reason shown.
   bool exportPose(const QString& path);
+  /// Writes the final pose as a DICOM Spatial Registration object (RegistrationDicomExport) referring to the CT and
+  /// the DICOM X-rays; warnings (e.g. a generated Frame of Reference UID) are shown. False with the reason shown.
+  bool exportDicomRegistration(const QString& path);
   /// Saves the X-ray views side by side as a PNG. False with the reason shown.
   bool saveScreenshot(const QString& path);
   /// Sets the OpenIGTLink server that "Send to Slicer" sends to (3D Slicer's OpenIGTLinkIF; default localhost:18944).

@@ -9,6 +9,7 @@
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/XrayLoader.h"
+#include "IO/Project/DicomViewBuilder.h"
 #include "Registration/RegistrationViewLoader.h"
 
 namespace fct {
@@ -92,27 +93,29 @@ void StudioDocument::setViews(LoadedViews loaded) {
 }
 
 Result<RegistrationView> StudioDocument::readXrayFile(const fs::path& path) {
-  auto image = XrayLoader::load(path);
-  if (!image) return fail(image.error());
-  if (!image.value().camera) {
-    return fail(fmt::format("{} has no C-arm geometry (DICOM distance and angle tags); open a view file that lists "
-                            "this image with its calibrated camera instead",
-                            path.string()));
+  const std::string advice = "open a view file that lists this image with its calibrated camera instead";
+  if (XrayLoader::isPlainImageFile(path)) {
+    return fail(fmt::format("{} has no C-arm geometry (a PNG/TIFF carries no DICOM distance and angle tags); {}",
+                            path.string(), advice));
   }
-  const Camera camera = *image.value().camera;
-  Result<RegistrationView> view(RegistrationView{path.stem().string(), std::move(image).value(), camera, {}});
+  auto spec = DicomViewBuilder::build({path});
+  if (!spec) return fail(fmt::format("{}; {}", spec.error(), advice));
+  auto view = RegistrationViewLoader::loadView(spec.value().front());
+  if (!view) return fail(view.error());
+  for (const std::string& warning : spec.warnings()) view.addWarning(warning);
   return view;
 }
 
 Status StudioDocument::addXrayFile(const fs::path& path) {
   auto read = readXrayFile(path);
   if (!read) return fail(read.error());
+  const std::vector<std::string> warnings = read.warnings();
   std::vector<RegistrationView> views;
   views.push_back(std::move(read).value());
-  return addXrayViews(std::move(views));
+  return addXrayViews(std::move(views), warnings);
 }
 
-Status StudioDocument::addXrayViews(std::vector<RegistrationView> added) {
+Status StudioDocument::addXrayViews(std::vector<RegistrationView> added, const std::vector<std::string>& warnings) {
   if (!m_viewFilePath.empty()) {
     const std::string file = added.empty() ? std::string("the X-rays") : added.front().xray.sourcePath;
     return fail(fmt::format("the views come from the view file {}; list {} in that file, or open the X-ray files "
@@ -128,8 +131,9 @@ Status StudioDocument::addXrayViews(std::vector<RegistrationView> added) {
     names.insert(view.name);
     views.push_back(std::move(view));
   }
-  std::vector<std::string> warnings = m_viewWarnings;
-  setViews(std::move(views), {}, std::move(warnings));
+  std::vector<std::string> allWarnings = m_viewWarnings;
+  allWarnings.insert(allWarnings.end(), warnings.begin(), warnings.end());
+  setViews(std::move(views), {}, std::move(allWarnings));
   return Ok{};
 }
 

@@ -109,16 +109,17 @@ class StudioDocument : public QObject {
   /// Puts views read by readViews() into the document with their ground truth; emits viewsChanged() and
   /// truthPoseChanged().
   void setViews(LoadedViews loaded);
-  /// Reads one X-ray file (DICOM or PNG/TIFF) as a view named after the file, without touching any document. Fails
-  /// when the file cannot be read or has no geometry (DICOM C-arm tags); the message says to use a view file.
+  /// Reads one X-ray DICOM file as a view named after the file, its camera from the C-arm geometry tags
+  /// (DicomViewBuilder; a mirrored image is flipped), without touching any document. Fails when the file cannot be
+  /// read or lacks geometry (naming the tag), or is a PNG/TIFF; the message says to use a view file.
   static Result<RegistrationView> readXrayFile(const std::filesystem::path& path);
   /// Adds one X-ray file (DICOM or PNG/TIFF) as a view; it needs its own geometry (DICOM C-arm tags), otherwise the
   /// Status says to use a view file. The view is named after the file (made unique). Refused while the views come
   /// from a view file. Emits viewsChanged().
   Status addXrayFile(const std::filesystem::path& path);
-  /// Adds views read by readXrayFile() (names made unique); refused while the views come from a view file. Emits
-  /// viewsChanged() once.
-  Status addXrayViews(std::vector<RegistrationView> views);
+  /// Adds views read by readXrayFile() (names made unique) and their warnings; refused while the views come from a
+  /// view file. Emits viewsChanged() once.
+  Status addXrayViews(std::vector<RegistrationView> views, const std::vector<std::string>& warnings = {});
   /// Replaces the views and the view file path; emits viewsChanged().
   void setViews(std::vector<RegistrationView> views, std::filesystem::path viewFile = {},
                 std::vector<std::string> warnings = {});

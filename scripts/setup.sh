@@ -11,7 +11,7 @@ FCT_PACKAGES=(
   qt6-base-dev libqt6opengl6-dev libxkbcommon-dev libgl-dev libvtk9-dev libeigen3-dev libopencv-dev libdcmtk-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev libfmt-dev libtbb-dev libcli11-dev zlib1g-dev libopenigtlink-dev
   libxml2-dev
-  xvfb xauth plastimatch parallel
+  xvfb xauth plastimatch parallel dicom3tools
 )
 # Opt-in: a one-node Slurm cluster for trying study-slurm.sbatch, installed only by scripts/slurm-local.sh.
 FCT_SLURM_PACKAGES=(slurm-wlm munge)

@@ -147,7 +147,7 @@ int printXray(const InfoOptions& options) {
     if (g.secondaryAngle_deg) tags["secondary_angle_deg"] = *g.secondaryAngle_deg;
     if (g.detectorActiveOrigin_mm) tags["detector_active_origin_mm"] = vectorJson(*g.detectorActiveOrigin_mm);
     if (header.missingGeometry.empty()) {
-      const auto camera = XrayDicomReader::cameraFromTags(g, header.cols, header.rows);
+      const auto camera = XrayGeometryReader::cameraFromTags(g, header.cols, header.rows);
       if (camera.ok()) {
         geometry = cameraJson(camera.value());
         geometry["tags"] = tags;

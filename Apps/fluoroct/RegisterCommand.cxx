@@ -1,5 +1,5 @@
 // fluoroct register: registers a CT to the X-ray views of a view file (Registration, a preset schedule) from an
-// initial pose given as a pose file or estimated from landmarks; writes RESULT.json. Also a 3D Slicer CLI module
+// initial pose given as a pose file or estimated from landmarks; writes RESULT.json (and a DICOM REG object). Also a 3D Slicer CLI module
 // (--xml, --tfm, --returnparameterfile; SlicerModule.h) and, with --igtl, sends the pose live to Slicer over
 // OpenIGTLink (Interop/IgtlTransformSender) once the result is written.
 #include <fmt/core.h>
@@ -25,6 +25,7 @@
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
 #include "Registration/Registration.h"
+#include "Registration/RegistrationDicomExport.h"
 #include "Registration/RegistrationResultJson.h"
 #include "Registration/RegistrationViewLoader.h"
 #include "SlicerModule.h"
@@ -53,6 +54,7 @@ struct Options {
   bool noMetalMask = false;
   double metalMinExcess = MetalMaskOptions{}.minExcess;
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
+  std::string dicomReg;  ///< optional DICOM Spatial Registration object (REG) of the final pose
   RegistrationAblation ablation;
   std::string tfm;                  ///< optional ITK transform file of the registered pose (Slicer's output transform)
   std::string returnParameterFile;  ///< optional "name = value" file of the scalar results (Slicer CLI modules)
@@ -468,7 +470,13 @@ int runRegister(const Options& o) {
   const Status written =
       writeResults(o, r, resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal), error));
   if (!written) return reportError(written.error());
+  if (!o.dicomReg.empty()) {
+    auto registration = RegistrationDicomExport::write(in.ct, in.views, r, o.dicomReg);
+    if (!registration) return reportError("--dicom-reg: " + registration.error());
+    printWarnings(registration.warnings());
+  }
   printResult(o, r, error);
+  if (!o.dicomReg.empty()) fmt::print("wrote DICOM registration {}\n", o.dicomReg);
   return link.value().sendFinal(r.T_world_from_ct, o);
 }
 
@@ -520,6 +528,9 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       ->needs(igtl);
   command->add_flag("--igtl-progress", options->igtlProgress, "With --igtl: also send the pose after each stage")
       ->needs(igtl);
+  command->add_option("--dicom-reg", options->dicomReg,
+                      "Also write the final pose as a DICOM Spatial Registration object (REG, .dcm) referring to the "
+                      "CT series and the DICOM X-rays (written atomically)");
   command->add_option("--truth", options->truth,
                       "Known true pose file (simulated cases): report the mean/max bone-surface distance to it");
   command->add_option("--overlays", options->overlays,

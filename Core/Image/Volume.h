@@ -4,10 +4,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "Base/Result.h"
+#include "Image/DicomIdentity.h"
 
 namespace fct {
 
@@ -63,6 +65,8 @@ class Volume {
 
   /// Free-text provenance: file or series read, resampling done, original scalar type.
   std::string description;
+  /// Patient, study, series, frame of reference and slices when read from a DICOM series; empty otherwise.
+  std::optional<DicomIdentity> dicom;
 
  private:
   Eigen::Vector3i m_dims = Eigen::Vector3i::Zero();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "Base/Result.h"
+#include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationView.h"
 
 namespace fct {
@@ -16,11 +17,18 @@ namespace fct {
 /// Loads registration views.
 class RegistrationViewLoader {
  public:
-  /// Reads the view file and every view's image, in the file's order. Fails naming the file and the view on a view
-  /// file error, a view without an image, an image that cannot be read, an image whose size is not the detector's, or
-  /// an unreadable dewarp file or one calibrated for another image size.
+  /// Reads the view file and every view's image, in the file's order (flipped left-right when the view says
+  /// mirror_columns, then dewarped when it names a dewarp file). Fails naming the file and the view on a view file
+  /// error, a view without an image, an image that cannot be read, an image whose size is not the detector's, or an
+  /// unreadable dewarp file or one calibrated for another image size.
   /// Warnings of the view file and of the images (the latter prefixed "view '<name>': ") are on the Result.
   static Result<std::vector<RegistrationView>> load(const std::filesystem::path& viewFile);
+
+  /// One view's image (XrayLoader; flipped left-right when the view says mirror_columns, then dewarped when it names a
+  /// dewarp file) with its camera and spheres. Fails naming the view when it has no image, the image cannot be read,
+  /// its size is not the detector's or its dewarp file is unusable; the
+  /// image's warnings are on the Result, prefixed "view '<name>': ".
+  static Result<RegistrationView> loadView(const ViewSpec& spec);
 };
 
 }  // namespace fct

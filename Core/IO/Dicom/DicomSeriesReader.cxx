@@ -15,6 +15,7 @@
 #include <optional>
 
 #include "IO/Dicom/DicomCodecs.h"
+#include "IO/Dicom/DicomIdentityReader.h"
 #include "IO/Dicom/SliceStack.h"
 
 namespace fct {
@@ -35,6 +36,7 @@ struct SliceHeader {
   std::optional<std::array<double, 6>> iop;
   std::optional<Eigen::Vector2d> pixelSpacing_mm;  // as in the file: (between rows, between columns)
   double slope = 1.0, intercept = 0.0;
+  DicomIdentity identity;  // patient, study, series, frame of reference and this file's SOP instance
   Eigen::Vector3d rowCosine() const { return {(*iop)[0], (*iop)[1], (*iop)[2]}; }
   Eigen::Vector3d columnCosine() const { return {(*iop)[3], (*iop)[4], (*iop)[5]}; }
 };
@@ -119,6 +121,7 @@ Result<SliceHeader> readHeader(const fs::path& path) {
   if (auto spacing = getDoubles<2>(ds, DCM_PixelSpacing)) h.pixelSpacing_mm = *spacing;
   if (auto slope = getDoubles<1>(ds, DCM_RescaleSlope)) h.slope = (*slope)[0];
   if (auto intercept = getDoubles<1>(ds, DCM_RescaleIntercept)) h.intercept = (*intercept)[0];
+  h.identity = DicomIdentityReader::read(ds);
   return h;
 }
 
@@ -419,6 +422,12 @@ Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeries
   }
   if (!volume) return fail(fmt::format("series {}: {}", uid, volume.error()));
   volume.value().description = std::move(description);
+  DicomIdentity identity = first.identity;
+  identity.instances.clear();
+  for (const SliceHeader& slice : headers) {
+    identity.instances.insert(identity.instances.end(), slice.identity.instances.begin(), slice.identity.instances.end());
+  }
+  volume.value().dicom = std::move(identity);
   for (std::string& warning : warnings) volume.addWarning(std::move(warning));
   return volume;
 }

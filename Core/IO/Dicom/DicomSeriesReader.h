@@ -40,6 +40,7 @@ class DicomSeriesReader {
   /// Reads one series as a Volume of HU (RescaleSlope/Intercept applied), geometry in LPS mm from
   /// ImagePositionPatient/ImageOrientationPatient/PixelSpacing (slice spacing from positions, not SliceThickness).
   /// Tilted or irregular series are resampled with a warning on the Result, or refused, per options.policy.
+  /// The Volume's `dicom` keeps the patient, study, series and frame of reference and every slice's SOP instance.
   /// Errors name the file and the tag: missing tags, mixed sizes or orientations, duplicate positions, truncated or
   /// undecodable pixel data, unknown series UID (the message lists the available ones).
   static Result<Volume> read(const std::filesystem::path& folder, const DicomSeriesReadOptions& options = {});

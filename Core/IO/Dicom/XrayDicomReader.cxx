@@ -7,7 +7,6 @@
 #include <dcmtk/dcmdata/dcxfer.h>
 #include <fmt/core.h>
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,47 +14,17 @@
 #include <cstring>
 
 #include "IO/Dicom/DicomCodecs.h"
+#include "IO/Dicom/DicomIdentityReader.h"
+#include "IO/Dicom/DicomValues.h"
 
 namespace fct {
 
 namespace {
 
-constexpr const char* kSidTag = "DistanceSourceToDetector (0018,1110)";
-constexpr const char* kSodTag = "DistanceSourceToPatient (0018,1111)";
-constexpr const char* kSpacingTag = "ImagerPixelSpacing (0018,1164) or PixelSpacing (0028,0030)";
+std::string stringTag(DcmItem& item, const DcmTagKey& tag) { return DicomValues::text(item, tag, 0); }
 
-std::string trimmed(const OFString& text) {
-  std::string s(text.c_str());
-  const auto first = s.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos) return {};
-  return s.substr(first, s.find_last_not_of(" \t\r\n") - first + 1);
-}
-
-std::string stringTag(DcmItem& item, const DcmTagKey& tag) {
-  OFString value;
-  if (item.findAndGetOFString(tag, value).bad()) return {};
-  return trimmed(value);
-}
-
-/// The value at `pos` of a numeric (DS/IS/FD/US) element, or nullopt when absent, empty or not finite.
 std::optional<double> numberTag(DcmItem& item, const DcmTagKey& tag, unsigned long pos = 0) {
-  Float64 value = 0.0;
-  if (item.findAndGetFloat64(tag, value, pos).good() && std::isfinite(value)) return value;
-  OFString text;  // IS and DS are strings; some DCMTK paths only expose them as text
-  if (item.findAndGetOFString(tag, text, pos).good() && !trimmed(text).empty()) {
-    char* end = nullptr;
-    const std::string s = trimmed(text);
-    const double parsed = std::strtod(s.c_str(), &end);
-    if (end != s.c_str() && std::isfinite(parsed)) return parsed;
-  }
-  return std::nullopt;
-}
-
-std::optional<Eigen::Vector2d> pairTag(DcmItem& item, const DcmTagKey& tag) {
-  const auto first = numberTag(item, tag, 0);
-  const auto second = numberTag(item, tag, 1);
-  if (!first || !second) return std::nullopt;
-  return Eigen::Vector2d(*first, *second);
+  return DicomValues::number(item, tag, pos);
 }
 
 std::optional<int> intTag(DcmItem& item, const DcmTagKey& tag) {
@@ -72,7 +41,8 @@ struct LoadedFile {
   bool signedPixels = false;
 };
 
-Status loadAndValidate(const std::filesystem::path& path, LoadedFile& loaded, std::vector<std::string>& warnings) {
+Status loadAndValidate(const std::filesystem::path& path, int frame, LoadedFile& loaded,
+                       std::vector<std::string>& warnings) {
   DicomCodecs::ensureRegistered();
   const std::string name = path.filename().string();
   std::error_code ec;
@@ -127,26 +97,15 @@ Status loadAndValidate(const std::filesystem::path& path, LoadedFile& loaded, st
   const E_TransferSyntax xfer = ds.getOriginalXfer();
   h.transferSyntax = DcmXfer(xfer).getXferName();
 
-  XrayGeometryTags& g = h.geometry;
-  g.sourceToDetector_mm = numberTag(ds, DCM_DistanceSourceToDetector);
-  g.sourceToPatient_mm = numberTag(ds, DCM_DistanceSourceToPatient);
-  // DICOM spacing order is (row spacing, column spacing) = (dv, du).
-  if (const auto imager = pairTag(ds, DCM_ImagerPixelSpacing)) {
-    g.pixelSpacing_mm = Eigen::Vector2d(imager->y(), imager->x());
-  } else if (const auto plain = pairTag(ds, DCM_PixelSpacing)) {
-    g.pixelSpacing_mm = Eigen::Vector2d(plain->y(), plain->x());
-    warnings.push_back(fmt::format("'{}': pixel spacing taken from PixelSpacing (0028,0030), which may be calibrated "
-                                   "at the patient rather than at the detector; check it",
-                                   name));
-  }
-  g.primaryAngle_deg = numberTag(ds, DCM_PositionerPrimaryAngle);
-  g.secondaryAngle_deg = numberTag(ds, DCM_PositionerSecondaryAngle);
-  if (const auto origin = pairTag(ds, DCM_DetectorActiveOrigin)) {
-    g.detectorActiveOrigin_mm = Eigen::Vector2d(origin->y(), origin->x());  // DICOM order is (row, column)
-  }
-  if (!g.sourceToDetector_mm) h.missingGeometry.emplace_back(kSidTag);
-  if (!g.sourceToPatient_mm) h.missingGeometry.emplace_back(kSodTag);
-  if (!g.pixelSpacing_mm) h.missingGeometry.emplace_back(kSpacingTag);
+  h.identity = DicomIdentityReader::read(ds);
+  auto geometry = XrayGeometryReader::readTags(ds, frame, h.frames);
+  if (!geometry) return fail(fmt::format("'{}': {}", name, geometry.error()));
+  for (const auto& w : geometry.warnings()) warnings.push_back(fmt::format("'{}': {}", name, w));
+  h.geometry = geometry.value();
+  const XrayGeometryTags& g = h.geometry;
+  if (!g.sourceToDetector_mm) h.missingGeometry.emplace_back(XrayGeometryReader::kSourceToDetectorTag);
+  if (!g.sourceToPatient_mm) h.missingGeometry.emplace_back(XrayGeometryReader::kSourceToPatientTag);
+  if (!g.pixelSpacing_mm) h.missingGeometry.emplace_back(XrayGeometryReader::kPixelSpacingTag);
   return Ok{};
 }
 
@@ -196,42 +155,12 @@ Result<std::vector<float>> modalityTable(DcmItem& ds, const LoadedFile& loaded, 
   return table;
 }
 
-/// The DICOM patient-direction letter (L/R, P/A, H/F) closest to a direction in LPS.
-char directionLetter(const Eigen::Vector3d& direction_lps) {
-  Eigen::Index axis = 0;
-  direction_lps.cwiseAbs().maxCoeff(&axis);
-  static constexpr std::array<char, 3> kPositive{'L', 'P', 'H'};
-  static constexpr std::array<char, 3> kNegative{'R', 'A', 'F'};
-  return direction_lps[axis] >= 0.0 ? kPositive[static_cast<std::size_t>(axis)] : kNegative[static_cast<std::size_t>(axis)];
-}
-
-/// A warning when PatientOrientation (0020,0020) contradicts the camera's column/row directions (e.g. an image
-/// stored mirrored, as displayed); empty when the tag is absent, not in biped letters, or consistent.
-std::string orientationConflict(DcmItem& ds, const Camera& camera, const std::string& name) {
-  const std::string columnTag = stringTag(ds, DCM_PatientOrientation);
-  OFString rowText;
-  if (columnTag.empty() || ds.findAndGetOFString(DCM_PatientOrientation, rowText, 1).bad()) return {};
-  const std::string rowTag = trimmed(rowText);
-  const std::string letters = "LRAPHF";
-  if (rowTag.empty() || letters.find(columnTag[0]) == std::string::npos || letters.find(rowTag[0]) == std::string::npos) {
-    return {};
-  }
-  const Eigen::Matrix3d R = camera.T_world_from_camera().linear();
-  const char column = directionLetter(R.col(0));
-  const char row = directionLetter(R.col(1));
-  if (column == columnTag[0] && row == rowTag[0]) return {};
-  return fmt::format("'{}': PatientOrientation (0020,0020) is {}\\{} but the camera from the positioner angles has "
-                     "columns toward {} and rows toward {}; the image is probably stored mirrored or rotated (as "
-                     "displayed) - flip it to the view from the source or supply the camera in a view file",
-                     name, columnTag, rowTag, column, row);
-}
-
 }  // namespace
 
-Result<XrayDicomHeader> XrayDicomReader::readHeader(const std::filesystem::path& path) {
+Result<XrayDicomHeader> XrayDicomReader::readHeader(const std::filesystem::path& path, int frame) {
   LoadedFile loaded;
   std::vector<std::string> warnings;
-  if (Status status = loadAndValidate(path, loaded, warnings); !status) return fail(status.error());
+  if (Status status = loadAndValidate(path, frame, loaded, warnings); !status) return fail(status.error());
   Result<XrayDicomHeader> result(std::move(loaded.header));
   for (auto& w : warnings) result.addWarning(std::move(w));
   return result;
@@ -240,13 +169,9 @@ Result<XrayDicomHeader> XrayDicomReader::readHeader(const std::filesystem::path&
 Result<XrayImage> XrayDicomReader::read(const std::filesystem::path& path, int frameIndex) {
   LoadedFile loaded;
   std::vector<std::string> warnings;
-  if (Status status = loadAndValidate(path, loaded, warnings); !status) return fail(status.error());
+  if (Status status = loadAndValidate(path, frameIndex, loaded, warnings); !status) return fail(status.error());
   const XrayDicomHeader& h = loaded.header;
   const std::string name = path.filename().string();
-  if (frameIndex < 0 || frameIndex >= h.frames) {
-    return fail(fmt::format("frame {} is out of range: '{}' has {} frame{} (0..{})", frameIndex, name, h.frames,
-                            h.frames == 1 ? "" : "s", h.frames - 1));
-  }
   DcmDataset& ds = *loaded.file.getDataset();
   const E_TransferSyntax xfer = ds.getOriginalXfer();
   const bool encapsulated = DcmXfer(xfer).isEncapsulated();
@@ -312,15 +237,18 @@ Result<XrayImage> XrayDicomReader::read(const std::filesystem::path& path, int f
   }
 
   if (h.missingGeometry.empty()) {
-    auto camera = cameraFromTags(h.geometry, h.cols, h.rows);
-    for (const auto& w : camera.warnings()) warnings.push_back(w);
-    if (camera) {
-      image.camera = camera.value();
-      if (std::string conflict = orientationConflict(ds, camera.value(), name); !conflict.empty()) {
-        warnings.push_back(std::move(conflict));
-      }
-    } else {
+    auto camera = XrayGeometryReader::frameCamera(h.geometry, h.cols, h.rows, {});
+    for (const auto& w : camera.warnings()) warnings.push_back(fmt::format("'{}': {}", name, w));
+    if (!camera) {
       warnings.push_back(fmt::format("'{}': no camera from the DICOM tags: {}", name, camera.error()));
+    } else if (camera.value().mirrorColumns) {
+      warnings.push_back(fmt::format("'{}': PatientOrientation (0020,0020) {} says the image is stored mirrored (as "
+                                     "displayed) against the view from the source, so no camera is attached to the "
+                                     "stored pixels; a view with \"mirror_columns\": true flips it ('fluoroct views "
+                                     "--from-dicom' writes one)",
+                                     name, h.geometry.patientOrientation));
+    } else {
+      image.camera = camera.value().camera;
     }
   } else {
     std::string missing;
@@ -331,62 +259,6 @@ Result<XrayImage> XrayDicomReader::read(const std::filesystem::path& path, int f
   Result<XrayImage> result(std::move(image));
   for (auto& w : warnings) result.addWarning(std::move(w));
   return result;
-}
-
-Result<Camera> XrayDicomReader::cameraFromTags(const XrayGeometryTags& tags, int cols, int rows) {
-  std::string missing;
-  auto need = [&missing](bool present, const char* tag, const char* key) {
-    if (present) return;
-    missing += fmt::format("{}missing {}", missing.empty() ? "" : "; ", tag);
-    missing += fmt::format(" (supply {} in a view file)", key);
-  };
-  need(tags.sourceToDetector_mm.has_value(), kSidTag, "source_to_detector_mm");
-  need(tags.sourceToPatient_mm.has_value(), kSodTag, "source_to_patient_mm");
-  need(tags.pixelSpacing_mm.has_value(), kSpacingTag, "pixel_spacing_mm");
-  if (!missing.empty()) return fail(fmt::format("cannot build the C-arm camera from the DICOM tags: {}", missing));
-
-  const double sid = *tags.sourceToDetector_mm;
-  const double sod = *tags.sourceToPatient_mm;
-  if (!(sod > 0.0) || !(sid > sod)) {
-    return fail(fmt::format("implausible distances: DistanceSourceToPatient {} mm must be positive and smaller than "
-                            "DistanceSourceToDetector {} mm",
-                            sod, sid));
-  }
-  CameraIntrinsics intrinsics;
-  intrinsics.cols = cols;
-  intrinsics.rows = rows;
-  intrinsics.pixelSpacing_mm = *tags.pixelSpacing_mm;
-  intrinsics.sourceToDetector_mm = sid;
-  intrinsics.principalPoint_px = Eigen::Vector2d(0.5 * (cols - 1), 0.5 * (rows - 1));
-
-  std::vector<std::string> warnings;
-  if (!tags.primaryAngle_deg) warnings.emplace_back("PositionerPrimaryAngle (0018,1510) absent: assumed 0 deg (no LAO/RAO)");
-  if (!tags.secondaryAngle_deg) {
-    warnings.emplace_back("PositionerSecondaryAngle (0018,1511) absent: assumed 0 deg (no cranial/caudal tilt)");
-  }
-  if (tags.detectorActiveOrigin_mm) {
-    warnings.push_back(fmt::format("DetectorActiveOrigin (0018,7028) = ({}, {}) mm is recorded but the physical "
-                                   "detector size is not; principal point taken at the image centre",
-                                   tags.detectorActiveOrigin_mm->x(), tags.detectorActiveOrigin_mm->y()));
-  }
-  constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-  const double primary_rad = tags.primaryAngle_deg.value_or(0.0) * kDegToRad;
-  const double secondary_rad = tags.secondaryAngle_deg.value_or(0.0) * kDegToRad;
-  // R0: camera axes at 0/0 in LPS: +x (columns) to the patient's right, +y (rows) to the feet, +z (beam) anterior.
-  Eigen::Matrix3d R0;
-  R0.col(0) = Eigen::Vector3d(-1, 0, 0);
-  R0.col(1) = Eigen::Vector3d(0, 0, -1);
-  R0.col(2) = Eigen::Vector3d(0, -1, 0);
-  const Eigen::Matrix3d R_world_from_camera = (Eigen::AngleAxisd(primary_rad, Eigen::Vector3d::UnitZ()) *
-                                               Eigen::AngleAxisd(-secondary_rad, Eigen::Vector3d::UnitX()))
-                                                  .toRotationMatrix() *
-                                              R0;
-  Eigen::Isometry3d T_world_from_camera = Eigen::Isometry3d::Identity();
-  T_world_from_camera.linear() = R_world_from_camera;
-  T_world_from_camera.translation() = -sod * R_world_from_camera.col(2);  // isocentre at the world origin
-  auto camera = Camera::create(intrinsics, T_world_from_camera);
-  for (auto& w : warnings) camera.addWarning(std::move(w));
-  return camera;
 }
 
 }  // namespace fct

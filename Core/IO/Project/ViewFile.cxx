@@ -18,7 +18,8 @@ void addWarnings(std::vector<std::string>& warnings, std::vector<std::string> mo
   warnings.insert(warnings.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
 }
 
-/// The image path and frame of a view ("image": "ap.png" or {"path": "ap.dcm", "frame": 0}), made absolute
+/// The image path and frame of a view ("image": "ap.png" or {"path": "ap.dcm", "frame": 0, "mirror_columns": false}),
+/// made absolute
 /// against `folder`; checks that the file exists.
 void readImage(JsonReader& reader, const std::filesystem::path& folder, ViewSpec& view,
                std::vector<std::string>& warnings) {
@@ -30,7 +31,8 @@ void readImage(JsonReader& reader, const std::filesystem::path& folder, ViewSpec
   } else if (image->is_object()) {
     relative = reader.string("image.path");
     view.frame = reader.has("image.frame") ? reader.integer("image.frame", 0) : 0;
-    addWarnings(warnings, reader.unknownKeys({"path", "frame"}, "image"));
+    view.mirrorColumns = reader.has("image.mirror_columns") && reader.boolean("image.mirror_columns");
+    addWarnings(warnings, reader.unknownKeys({"path", "frame", "mirror_columns"}, "image"));
   } else {
     reader.rejectKey("image", fmt::format("must be a file name or {{\"path\": ..., \"frame\": ...}}, got {}",
                                           JsonReader::describe(*image)));
@@ -190,6 +192,7 @@ Status ViewFile::write(const std::vector<ViewSpec>& views, const std::filesystem
     v["name"] = view.name;
     if (!view.imagePath.empty()) {
       v["image"] = ordered_json{{"path", pathForFile(view.imagePath, folder)}, {"frame", view.frame}};
+      if (view.mirrorColumns) v["image"]["mirror_columns"] = true;
     }
     if (!view.dewarpPath.empty()) v["dewarp"] = pathForFile(view.dewarpPath, folder);
     v["detector"] = ordered_json{{"cols", in.cols},

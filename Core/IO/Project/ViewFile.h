@@ -21,6 +21,7 @@ struct ViewSpec {
   Camera camera;
   std::vector<PixelCircle> calibrationSpheres;  ///< shadows of calibration-grid spheres, masked out of the comparison
   std::filesystem::path dewarpPath;  ///< the view's dewarp file (DewarpFile); empty if none; absolute after read
+  bool mirrorColumns = false;  ///< flip the image left-right on load (a DICOM stored mirrored against the camera)
 };
 
 /// Reads and writes view files.

@@ -8,6 +8,7 @@
 #include <map>
 
 #include "Base/JsonDocument.h"
+#include "IO/Dicom/DicomRegistrationReader.h"
 #include "IO/Project/LandmarkFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
@@ -94,6 +95,31 @@ TEST(RegisterCommand, ResultFileReadsBackAsARegistrationResult) {
   auto pose = fct::PoseFile::read(dir / "result.json");
   ASSERT_TRUE(pose.ok()) << pose.error();
   EXPECT_TRUE(pose.value().isApprox(result.value().T_world_from_ct, 1e-12));
+}
+
+TEST(RegisterCommand, WritesTheFinalPoseAsADicomRegistration) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
+  const std::string base = fmt::format("register --ct '{}' --views '{}' --init '{}' --preset fast --local-only --out '{}'",
+                                       (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(),
+                                       (dir / "init.json").string(), (dir / "result.json").string());
+  const auto run = fct::test::runCli(base + fmt::format(" --dicom-reg '{}'", (dir / "reg.dcm").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("wrote DICOM registration"), std::string::npos) << run.out;
+  EXPECT_NE(run.err.find("generated Frame of Reference UID"), std::string::npos) << "a NRRD CT: " << run.err;
+  auto pose = fct::PoseFile::read(dir / "result.json");
+  ASSERT_TRUE(pose.ok()) << pose.error();
+  auto registration = fct::DicomRegistrationReader::read(dir / "reg.dcm");
+  ASSERT_TRUE(registration.ok()) << registration.error();
+  EXPECT_TRUE(registration.value().T_world_from_ct.matrix().isApprox(pose.value().matrix(), 1e-8));
+
+  // An unwritable REG path fails with one error line, after the result file is safely written.
+  fs::remove(dir / "result.json");
+  const auto refused = fct::test::runCli(base + fmt::format(" --dicom-reg '{}'", (dir / "no" / "reg.dcm").string()));
+  EXPECT_TRUE(oneErrorLine(refused)) << refused.err;
+  EXPECT_NE(refused.err.find("--dicom-reg"), std::string::npos) << refused.err;
+  EXPECT_TRUE(fs::exists(dir / "result.json"));
 }
 
 TEST(RegisterCommand, EstimatesTheInitialPoseFromLandmarks) {

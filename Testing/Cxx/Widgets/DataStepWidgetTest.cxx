@@ -5,6 +5,8 @@
 
 #include <fstream>
 
+#include "../Core/SyntheticXrayDicom.h"
+#include "IO/Project/DicomViewBuilder.h"
 #include "StudioTestCase.h"
 #include "TestSupport.h"
 #include "Widgets/DataStepWidget.h"
@@ -40,6 +42,43 @@ TEST(DataStepWidget, LoadsTheBuiltinCaseFolderAndDescribesIt) {
   EXPECT_TRUE(summary.contains(QStringLiteral("96 × 96 × 72 voxels"))) << summary.toStdString();
   EXPECT_TRUE(summary.contains(QStringLiteral("Ground truth"))) << summary.toStdString();
   EXPECT_TRUE(step.errorText().isEmpty());
+}
+
+TEST(DataStepWidget, ViewsFromDicomTagsAddsOneViewPerFileWithAMirroredImageFlipped) {
+  const auto dir = fct::test::scratchDir();
+  auto xa = [&dir](const char* name, const char* orientation) {
+    fct::test::SyntheticXray x;
+    x.cols = 6;
+    x.rows = 4;
+    for (int i = 0; i < 24; ++i) x.samples.push_back(static_cast<Uint16>(100 + i));
+    DcmFileFormat file = x.build();
+    fct::test::putCarmTags(*file.getDataset(), 1000, 700, 0.5, 0.5, 20, 0);
+    file.getDataset()->putAndInsertString(DCM_PatientOrientation, orientation);
+    return fct::test::save(file, dir / name);
+  };
+  const auto fromSource = xa("source.dcm", "R\\F");
+  const auto displayed = xa("displayed.dcm", "L\\F");
+  StudioDocument document;
+  DataStepWidget step(&document);
+  QSignalSpy finished(&step, &DataStepWidget::loadFinished);
+  step.addXrayFiles({QString::fromStdString(fromSource.string()), QString::fromStdString(displayed.string())});
+  const auto [ok, message] = waitForLoad(finished);
+  ASSERT_TRUE(ok) << message.toStdString() << " / " << step.errorText().toStdString();
+  ASSERT_EQ(document.views().size(), 2u);
+  EXPECT_EQ(document.views()[0].name, "source");
+  EXPECT_FLOAT_EQ(document.views()[0].xray.at(0, 0), 100.0f);
+  EXPECT_FLOAT_EQ(document.views()[1].xray.at(0, 0), 105.0f) << "the mirrored image is flipped left-right";
+  auto expected = fct::DicomViewBuilder::build({displayed});
+  ASSERT_TRUE(expected) << expected.error();
+  EXPECT_TRUE(document.views()[1].camera.P_px_from_world().isApprox(expected.value()[0].camera.P_px_from_world()));
+
+  const auto png = dir / "plain.png";
+  std::ofstream(png) << "not really a PNG";
+  step.addXrayFiles({QString::fromStdString(png.string())});
+  const auto [refused, why] = waitForLoad(finished);
+  EXPECT_FALSE(refused);
+  EXPECT_TRUE(why.contains(QStringLiteral("view file"))) << why.toStdString();
+  EXPECT_EQ(document.views().size(), 2u);
 }
 
 TEST(DataStepWidget, NonDicomFolderShowsAMessageAndKeepsTheCt) {

@@ -5,6 +5,7 @@
 #include <QImage>
 
 #include "Evaluation/PoseOffset.h"
+#include "IO/Dicom/DicomRegistrationReader.h"
 #include "IO/Project/ItkTransformFile.h"
 #include "IO/Project/PoseFile.h"
 #include "StepTestSession.h"
@@ -87,6 +88,26 @@ TEST(ReviewStepWidget, AcceptRejectAndExportsReadBack) {
   EXPECT_NE(step.message().indexOf(QStringLiteral("Cannot write")), -1);
 }
 
+TEST(ReviewStepWidget, ExportsTheFinalPoseAsADicomRegistration) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  const Eigen::Isometry3d finalPose =
+      fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, 0.5, 9).value();
+  session.document.setResult(resultAt(session, finalPose));
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  const auto dir = fct::test::scratchDir();
+  ASSERT_TRUE(step.exportDicomRegistration(QString::fromStdString((dir / "reg.dcm").string())))
+      << step.message().toStdString();
+  EXPECT_NE(step.message().indexOf(QStringLiteral("generated Frame of Reference UID")), -1)
+      << "the phantom CT is no DICOM series: " << step.message().toStdString();
+  auto registration = fct::DicomRegistrationReader::read(dir / "reg.dcm");
+  ASSERT_TRUE(registration.ok()) << registration.error();
+  EXPECT_TRUE(registration.value().T_world_from_ct.matrix().isApprox(finalPose.matrix(), 1e-8));
+  EXPECT_FALSE(step.exportDicomRegistration(QString::fromStdString((dir / "missing" / "reg.dcm").string())));
+  EXPECT_NE(step.message().indexOf(QStringLiteral("Cannot export the DICOM registration")), -1)
+      << step.message().toStdString();
+}
+
 TEST(ReviewStepWidget, WithoutAResultExportIsRefusedWithAMessage) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   fct::ReviewStepWidget step(&session.document);
@@ -96,6 +117,8 @@ TEST(ReviewStepWidget, WithoutAResultExportIsRefusedWithAMessage) {
   EXPECT_FALSE(step.exportPose(QString::fromStdString((dir / "pose.tfm").string())));
   EXPECT_NE(step.message().indexOf(QStringLiteral("No registration result")), -1) << step.message().toStdString();
   EXPECT_FALSE(std::filesystem::exists(dir / "pose.tfm"));
+  EXPECT_FALSE(step.exportDicomRegistration(QString::fromStdString((dir / "reg.dcm").string())));
+  EXPECT_FALSE(std::filesystem::exists(dir / "reg.dcm"));
   step.acceptResult();
   EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided);
 }

@@ -59,6 +59,22 @@ TEST(RegistrationViewLoader, LoadsEveryViewWithItsImageCameraAndSpheresInFileOrd
   EXPECT_EQ(views.value()[1].spheres[0].radius_px, 3.0);
 }
 
+TEST(RegistrationViewLoader, FlipsAViewMarkedMirrorColumnsLeftRight) {
+  const fs::path dir = fct::test::scratchDir();
+  writeImage(dir / "ap.png", 48, 32);
+  writeImage(dir / "lat.png", 48, 32);
+  std::vector<fct::ViewSpec> specs = twoViews(dir);
+  specs[1].mirrorColumns = true;
+  ASSERT_TRUE(fct::ViewFile::write(specs, dir / "views.json").ok());
+  auto views = fct::RegistrationViewLoader::load(dir / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  const fct::XrayImage& plain = views.value()[0].xray;
+  const fct::XrayImage& mirrored = views.value()[1].xray;  // the same gradient, flipped
+  for (int row : {0, 17, 31}) {
+    for (int col : {0, 5, 47}) EXPECT_FLOAT_EQ(mirrored.at(col, row), plain.at(47 - col, row)) << col << "," << row;
+  }
+}
+
 TEST(RegistrationViewLoader, RefusesAViewWithoutAnImageNamingFileAndView) {
   const fs::path dir = fct::test::scratchDir();
   writeImage(dir / "ap.png", 48, 32);

@@ -133,6 +133,11 @@ TEST(DicomSeriesReader, ReadsSyntheticSeriesGeometryAndHu) {
     EXPECT_FLOAT_EQ(v.at(4, 3, k), 2.0f * (-3 + 4 + 21) - 1000.0f);
   }
   EXPECT_TRUE(contains(v.description, slice.seriesUid));
+  ASSERT_TRUE(v.dicom.has_value());  // kept for objects that refer back to the series (a DICOM registration)
+  EXPECT_EQ(v.dicom->seriesInstanceUid, slice.seriesUid);
+  EXPECT_EQ(v.dicom->modality, "CT");
+  ASSERT_EQ(v.dicom->instances.size(), 3u);
+  EXPECT_EQ(v.dicom->instances[0].sopClassUid, UID_CTImageStorage);
 }
 
 TEST(DicomSeriesReader, ReadsUnsignedAndRleCompressedPixels) {
@@ -348,6 +353,10 @@ TEST(DicomSeriesReader, LoadsPhilipsHeadPhantomGeometry) {
   EXPECT_LE(lo, -1000.0f);
   EXPECT_GT(hi, 1000.0f);
   EXPECT_NEAR(v.at(5, 5, 70), -1000.0f, 100.0f);  // air in the corner
+  ASSERT_TRUE(v.dicom.has_value());
+  EXPECT_EQ(v.dicom->instances.size(), 140u);
+  EXPECT_FALSE(v.dicom->studyInstanceUid.empty());
+  EXPECT_FALSE(v.dicom->frameOfReferenceUid.empty());
 }
 
 TEST(DicomSeriesReader, ScanListsPhilipsHeadPhantomSeries) {
