@@ -128,7 +128,9 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
         this, tr("Open a CT volume file"), {}, tr("Volumes (*.nii *.nii.gz *.nrrd *.nhdr *.mha *.mhd);;All files (*)"));
     if (!file.isEmpty()) openCt(file);
   });
-  connect(m_loadSeries, &QPushButton::clicked, this, &DataStepWidget::loadChosenSeries);
+  connect(m_loadSeries, &QPushButton::clicked, this, [this] {
+    if (mayChangeInputs()) loadChosenSeries();
+  });
   connect(m_openViews, &QPushButton::clicked, this, [this] {
     const QString file = QFileDialog::getOpenFileName(this, tr("Open a view file"), {},
                                                       tr("View files (*.json);;All files (*)"));
@@ -183,6 +185,8 @@ void DataStepWidget::setBusy(bool busy, const QString& what) {
   }
 }
 
+bool DataStepWidget::mayChangeInputs() const { return !m_busy && (!m_inputGuard || m_inputGuard()); }
+
 void DataStepWidget::reportError(const QString& what, const std::string& message) {
   const QString text = what + QStringLiteral(": ") + qs(message);
   m_error->setText(text);
@@ -197,7 +201,7 @@ void DataStepWidget::reportSuccess(const QString& message) {
 }
 
 void DataStepWidget::openCt(const QString& path) {
-  if (m_busy) return;
+  if (!mayChangeInputs()) return;
   const fs::path p = path.toStdString();
   std::error_code ec;
   if (!fs::is_directory(p, ec)) {
@@ -263,7 +267,7 @@ void DataStepWidget::loadChosenSeries() {
 }
 
 void DataStepWidget::openViewFile(const QString& path) {
-  if (m_busy) return;
+  if (!mayChangeInputs()) return;
   const fs::path p = path.toStdString();
   runInBackground<Result<LoadedViews>>(
       tr("Loading the views of %1…").arg(qs(p.filename())), [p] { return StudioDocument::readViews(p); },
@@ -277,7 +281,7 @@ void DataStepWidget::openViewFile(const QString& path) {
 }
 
 void DataStepWidget::addXrayFiles(const QStringList& paths) {
-  if (m_busy || paths.isEmpty()) return;
+  if (paths.isEmpty() || !mayChangeInputs()) return;
   std::vector<fs::path> files;
   for (const QString& path : paths) files.push_back(path.toStdString());
   using Views = Result<std::vector<RegistrationView>>;
@@ -325,7 +329,7 @@ Result<DataStepWidget::CaseFiles> DataStepWidget::findCaseFiles(const fs::path& 
 }
 
 void DataStepWidget::openCaseFolder(const QString& folder) {
-  if (m_busy) return;
+  if (!mayChangeInputs()) return;
   auto files = findCaseFiles(folder.toStdString());
   if (!files) return reportError(tr("Could not open the case folder"), files.error());
   const CaseFiles f = files.value();
@@ -347,6 +351,7 @@ void DataStepWidget::openCaseFolder(const QString& folder) {
       [this, folder](Result<LoadedCase>& loaded) {
         if (!loaded) return reportError(tr("Could not open the case folder"), loaded.error());
         LoadedCase& c = loaded.value();
+        m_document->setSessionPath({});  // another case: saving must not overwrite the old case's session file
         m_document->setCt(std::move(c.ct));
         m_document->setViews(std::move(c.views));
         if (c.initialPose) {

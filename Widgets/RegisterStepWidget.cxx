@@ -278,9 +278,13 @@ void RegisterStepWidget::onFinished(const RegistrationResult& result) {
     appendLog(summary);
     showMessage(summary, true);
   } else {
+    if (!m_document->addResult(result)) {
+      summary += tr(" The accepted result stays current; this run is kept as result %1 of the history: compare it in "
+                    "the Review step.")
+                     .arg(m_document->results().size());
+    }
     appendLog(summary);
     showMessage(summary, false);
-    m_document->setResult(result);
   }
   setRunningUi(false);
   emit runningChanged(false);

@@ -3,8 +3,9 @@
 // RegistrationWorker on its own thread from the document's initial pose, with the document's ROI window and
 // fraction in every ROI stage; a progress bar (stage, DRRs, best similarity) and a log follow it through queued
 // signals while the window stays responsive. Cancel stops the run at the next DRR set; the best pose so far is kept
-// and marked cancelled. The result (finished or cancelled) goes into the document, unless the CT or the views changed
-// during the run (then it is reported and dropped).
+// and marked cancelled. The result (finished or cancelled) joins the document's result history, unless the CT or the
+// views changed during the run (then it is reported and dropped); it becomes the current result unless the current one
+// is accepted, which only the user replaces (Review step).
 
 #include <QString>
 #include <QWidget>

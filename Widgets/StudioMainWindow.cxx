@@ -15,6 +15,8 @@
 #include <QToolBox>
 #include <QVBoxLayout>
 
+#include <algorithm>
+
 #include "Widgets/DataStepWidget.h"
 #include "Widgets/LandmarkStepWidget.h"
 #include "Widgets/RegisterStepWidget.h"
@@ -138,8 +140,10 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   });
 
   m_dataStep = new DataStepWidget(m_document, this);
+  m_dataStep->setInputGuard([this] { return mayReplaceInputs(); });
   connect(m_dataStep, &DataStepWidget::statusMessage, this, &StudioMainWindow::showStatus);
   connect(m_dataStep, &DataStepWidget::loadFinished, this, [this](bool ok, const QString& message) {
+    updateTitle();
     if (ok) {
       m_messageBar->hide();
     } else {
@@ -368,14 +372,41 @@ void StudioMainWindow::offerAutosave() {
   }
 }
 
-bool StudioMainWindow::maybeSave() {
+QString StudioMainWindow::contentSummary() const {
+  const StudioDocument& d = *m_document;
+  QStringList parts;
+  if (d.ct()) parts << tr("the CT %1").arg(qs(d.ctPath().filename()));
+  if (!d.views().empty()) parts << tr("%n X-ray view(s)", nullptr, static_cast<int>(d.views().size()));
+  if (!d.landmarks().ct.empty()) parts << tr("%n landmark(s)", nullptr, static_cast<int>(d.landmarks().ct.size()));
+  if (d.initialPose()) parts << tr("an initial pose (%1)").arg(d.initialPoseSource());
+  if (!d.results().empty()) {
+    const auto accepted = std::count_if(d.results().begin(), d.results().end(), [](const StudioResult& r) {
+      return r.verdict == ResultVerdict::Accepted;
+    });
+    parts << tr("%n registration result(s)", nullptr, static_cast<int>(d.results().size())) +
+                 (accepted > 0 ? tr(" (%n accepted)", nullptr, static_cast<int>(accepted)) : QString());
+  }
+  return parts.isEmpty() ? tr("nothing yet") : parts.join(QStringLiteral(", "));
+}
+
+bool StudioMainWindow::maybeSave() { return askToSave({}); }
+
+bool StudioMainWindow::askToSave(const QString& lead) {
   if (!m_document->isModified()) return true;
-  const auto answer = QMessageBox::warning(this, tr("Unsaved changes"),
-                                           tr("The session has unsaved changes. Save them first?"),
-                                           QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,
-                                           QMessageBox::Save);
+  const QString name = m_document->sessionPath().empty() ? tr("The untitled session")
+                                                         : tr("The session %1").arg(qs(m_document->sessionPath().filename()));
+  const auto answer = QMessageBox::warning(
+      this, tr("Unsaved changes"),
+      lead + tr("%1 has unsaved changes. It holds %2.\n\nSave it first?").arg(name, contentSummary()),
+      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
   if (answer == QMessageBox::Save) return saveSession();
   return answer == QMessageBox::Discard;
+}
+
+bool StudioMainWindow::mayReplaceInputs() {
+  if (!m_document->hasDerivedState()) return true;
+  return askToSave(tr("New images replace the current ones: their landmarks, initial pose and registration results "
+                      "are dropped.\n\n"));
 }
 
 void StudioMainWindow::closeEvent(QCloseEvent* event) {

@@ -25,7 +25,7 @@ fct::RegistrationResult resultAt(const fct::test::StepTestSession& session, cons
 
 TEST(ReviewStepWidget, DrawsBothOutlinesAndTheDrrAndShowsTheSurfaceError) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
-  session.document.setResult(resultAt(session, session.T_truth));
+  session.document.addResult(resultAt(session, session.T_truth));
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
@@ -56,7 +56,7 @@ TEST(ReviewStepWidget, AcceptRejectAndExportsReadBack) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   const Eigen::Isometry3d finalPose =
       fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, 0.5, 9).value();
-  session.document.setResult(resultAt(session, finalPose));
+  session.document.addResult(resultAt(session, finalPose));
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);

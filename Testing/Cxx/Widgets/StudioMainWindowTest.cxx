@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <QAbstractButton>
+#include <QComboBox>
 #include <QApplication>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -15,6 +16,7 @@
 #include "StudioTestCase.h"
 #include "TestSupport.h"
 #include "Widgets/DataStepWidget.h"
+#include "Widgets/ReviewStepWidget.h"
 #include "Widgets/SessionAutosave.h"
 #include "Widgets/SliceViewWidget.h"
 #include "Widgets/StudioDocument.h"
@@ -196,6 +198,64 @@ TEST_F(StudioMainWindowTest, BadSessionShowsAMessageAndKeepsTheSession) {
   EXPECT_TRUE(window.lastMessage().contains(QStringLiteral("bad.fctsession.json")));
   EXPECT_EQ(window.document()->views().size(), 2u);
   EXPECT_EQ(window.document()->sessionPath(), m_folder / "good.fctsession.json");
+}
+
+TEST_F(StudioMainWindowTest, ACaseSwapAsksFirstThenDropsTheOldResultVerdictAndLandmarks) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  fct::StudioDocument& document = *window.document();
+  fct::Landmarks landmarks;
+  landmarks.ct = {{"L1", {1.0, 2.0, 3.0}}};
+  landmarks.imageByView["ap"] = {{"L1", {50.0, 60.0}}};
+  document.setLandmarks(landmarks);
+  fct::RegistrationResult result;
+  result.T_initial = *document.initialPose();
+  result.T_world_from_ct = result.T_initial;
+  document.addResult(result);
+  auto* review = window.findChild<fct::ReviewStepWidget*>();
+  ASSERT_NE(review, nullptr);
+  window.showStepNamed(QStringLiteral("review"));
+  review->acceptResult();
+  ASSERT_EQ(document.resultVerdict(), fct::ResultVerdict::Accepted);
+
+  // A second case (a copy of the built-in one): unsaved work is not dropped without asking; Cancel keeps it all.
+  const auto second = m_folder / "second_case";
+  std::filesystem::copy(fct::test::builtinCaseDir(), second, std::filesystem::copy_options::recursive);
+  QString question;
+  answerNextMessageBox(QMessageBox::Cancel, &question);
+  window.dataStep()->openCaseFolder(QString::fromStdString(second.string()));
+  EXPECT_TRUE(question.contains(QStringLiteral("registration results are dropped"))) << question.toStdString();
+  EXPECT_TRUE(question.contains(QStringLiteral("1 landmark"))) << question.toStdString();
+  EXPECT_TRUE(question.contains(QStringLiteral("1 accepted"))) << question.toStdString();
+  EXPECT_FALSE(window.dataStep()->isBusy()) << "cancelled: nothing loads";
+  EXPECT_EQ(document.resultVerdict(), fct::ResultVerdict::Accepted);
+
+  // Discard: the new case comes in and nothing derived from the old one survives.
+  QSignalSpy finished(window.dataStep(), &fct::DataStepWidget::loadFinished);
+  answerNextMessageBox(QMessageBox::Discard);
+  window.dataStep()->openCaseFolder(QString::fromStdString(second.string()));
+  ASSERT_TRUE(finished.wait(20000));
+  ASSERT_TRUE(finished.at(0).at(0).toBool()) << finished.at(0).at(1).toString().toStdString();
+  EXPECT_EQ(document.result(), nullptr);
+  EXPECT_TRUE(document.results().empty());
+  EXPECT_EQ(document.resultVerdict(), fct::ResultVerdict::Undecided);
+  EXPECT_TRUE(document.landmarks().ct.empty());
+  EXPECT_TRUE(document.landmarks().imageByView.empty());
+  ASSERT_TRUE(document.initialPose()) << "the new case's own initial pose";
+  EXPECT_TRUE(document.initialPoseSource().contains(QStringLiteral("initial_pose.json")));
+  EXPECT_TRUE(document.sessionPath().empty()) << "saving must not overwrite the first case's session";
+  EXPECT_EQ(review->historyChooser()->count(), 0);
+
+  // A saved session holds its work: then the swap needs no question.
+  ASSERT_TRUE(window.saveSessionTo(QString::fromStdString((m_folder / "second.fctsession.json").string())));
+  document.addResult(result);
+  ASSERT_TRUE(window.saveSessionTo(QString::fromStdString((m_folder / "second.fctsession.json").string())));
+  finished.clear();
+  window.dataStep()->openCaseFolder(QString::fromStdString(fct::test::builtinCaseDir().string()));
+  ASSERT_TRUE(finished.wait(20000));
+  EXPECT_TRUE(document.results().empty());
 }
 
 }  // namespace

@@ -66,7 +66,7 @@ void runScriptedSession(fct::test::StepTestSession& session, const std::string& 
   // Register (fast) and review.
   ASSERT_TRUE(registration.run()) << registration.message().toStdString();
   ASSERT_TRUE(fct::test::waitUntil([&] { return !registration.isRunning(); }, 300000));
-  ASSERT_TRUE(session.document.result().has_value()) << registration.message().toStdString();
+  ASSERT_TRUE(session.document.result() != nullptr) << registration.message().toStdString();
   EXPECT_FALSE(session.document.result()->cancelled);
   review.setActive(true);
   ASSERT_TRUE(review.finalSurfaceTre_mm().has_value()) << review.message().toStdString();
@@ -85,7 +85,13 @@ void runScriptedSession(fct::test::StepTestSession& session, const std::string& 
   ASSERT_TRUE(fct::test::waitUntil([&] { return registration.lastProgress().drrs > 0; }, 120000));
   registration.cancel();
   ASSERT_TRUE(fct::test::waitUntil([&] { return !registration.isRunning(); }, 120000));
-  ASSERT_TRUE(session.document.result().has_value());
+  ASSERT_EQ(session.document.results().size(), 2u) << "the cancelled run joins the history";
+  EXPECT_EQ(session.document.currentResultIndex(), 0) << "the accepted result stays current";
+  EXPECT_FALSE(session.document.result()->cancelled);
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Accepted);
+  EXPECT_NE(registration.message().indexOf(QStringLiteral("accepted result")), -1)
+      << registration.message().toStdString();
+  session.document.setCurrentResult(1);
   EXPECT_TRUE(session.document.result()->cancelled);
   EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided) << "a new result awaits a verdict";
   EXPECT_LE(session.surfaceError_mm(session.document.result()->T_world_from_ct), initialError_mm + 1e-6);
