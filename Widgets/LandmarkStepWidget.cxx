@@ -171,11 +171,8 @@ void LandmarkStepWidget::addCtLandmark(const Eigen::Vector3d& p_ct_mm) {
   landmarks.ct.push_back(CtLandmark{name, p_ct_mm});
   m_selected = QString::fromStdString(name);
   m_document->setLandmarks(std::move(landmarks));
-  showMessage(tr("Added %1 at (%2, %3, %4) mm; now click its partner in the X-ray views.")
-                  .arg(m_selected)
-                  .arg(p_ct_mm.x(), 0, 'f', 1)
-                  .arg(p_ct_mm.y(), 0, 'f', 1)
-                  .arg(p_ct_mm.z(), 0, 'f', 1),
+  showMessage(tr("Added %1 at %2; now click its partner in the X-ray views.")
+                  .arg(m_selected, SliceViewWidget::positionText(p_ct_mm)),
               false);
 }
 

@@ -86,11 +86,8 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
     connect(slice, &SliceViewWidget::pointClicked, this, &StudioMainWindow::setCrosshair);
     connect(slice, &SliceViewWidget::crosshairMoved, this, &StudioMainWindow::setCrosshair);
     connect(slice, &SliceViewWidget::ctPointHovered, this, [this, slice](const Eigen::Vector3d& p, float value) {
-      m_hover->setText(tr("%1: L %2  P %3  S %4 mm  %5 HU")
-                           .arg(SliceViewWidget::orientationName(slice->orientation()))
-                           .arg(p.x(), 0, 'f', 1)
-                           .arg(p.y(), 0, 'f', 1)
-                           .arg(p.z(), 0, 'f', 1)
+      m_hover->setText(tr("%1: %2  %3 HU")
+                           .arg(SliceViewWidget::orientationName(slice->orientation()), SliceViewWidget::positionText(p))
                            .arg(value, 0, 'f', 0));
     });
   }
@@ -417,6 +414,8 @@ void StudioMainWindow::closeEvent(QCloseEvent* event) {
   m_autosave->discard();
   event->accept();
 }
+
+QString StudioMainWindow::hoverText() const { return m_hover->text(); }
 
 QStringList StudioMainWindow::recentSessions() const { return QSettings().value(kRecentKey).toStringList(); }
 

@@ -74,6 +74,8 @@ class StudioMainWindow : public QMainWindow {
   /// The autosave of the document.
   SessionAutosave* autosave() const { return m_autosave; }
 
+  /// The position readout of the status line (CT point and value, or X-ray pixel and value), as shown.
+  QString hoverText() const;
   /// The last message shown in the message bar or status line.
   const QString& lastMessage() const { return m_lastMessage; }
   /// Recent session files, most recent first (QSettings "recentSessions").

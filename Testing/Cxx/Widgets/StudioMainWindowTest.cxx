@@ -119,6 +119,32 @@ TEST_F(StudioMainWindowTest, LoadsTheCaseIntoTheViewsAndLinksTheCrosshair) {
   EXPECT_TRUE(window.isWindowModified());
 }
 
+TEST_F(StudioMainWindowTest, SliceTitleAndReadoutGiveTheSamePatientSideInLps) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  fct::SliceViewWidget* axial = window.sliceViews()[0];
+  fct::SliceViewWidget* sagittal = window.sliceViews()[2];
+  // Click on the patient's right (LPS x < 0) in the axial view: the sagittal slice moves there.
+  const Eigen::Vector3d right(-20.0, 5.0, axial->slicePosition_mm());
+  QTest::mouseClick(axial, Qt::LeftButton, Qt::NoModifier, axial->widgetPointForCtPoint(right));
+  const double x = sagittal->crosshair_ct_mm().x();
+  ASSERT_LT(x, -15.0);
+  const QString side = fct::SliceViewWidget::sideCoordinate(0, x);
+  EXPECT_TRUE(side.startsWith(QStringLiteral("R "))) << side.toStdString();
+  EXPECT_TRUE(sagittal->title().contains(side + QStringLiteral(" mm (LPS x -"))) << sagittal->title().toStdString();
+  // Hovering the sagittal view at the crosshair reads the same side and the same LPS x.
+  QTest::mouseMove(sagittal, sagittal->widgetPointForCtPoint(sagittal->crosshair_ct_mm()));
+  const QString readout = window.hoverText();
+  EXPECT_TRUE(readout.startsWith(QStringLiteral("Sagittal: LPS (") + QString::number(x, 'f', 1)))
+      << readout.toStdString();
+  EXPECT_TRUE(readout.contains(QStringLiteral("= ") + side)) << readout.toStdString();
+  EXPECT_EQ(fct::SliceViewWidget::sideCoordinate(1, -12.34), QStringLiteral("A 12.3"));
+  EXPECT_EQ(fct::SliceViewWidget::sideCoordinate(2, -0.01), QStringLiteral("S 0.0")) << "no signed zero";
+}
+
 TEST_F(StudioMainWindowTest, AutosaveAppearsAfterAChangeAndIsRestoredAfterACrash) {
   const auto autosave = m_folder / "autosave.json";
   {
