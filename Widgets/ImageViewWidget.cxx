@@ -16,8 +16,9 @@ constexpr double kClickTolerance_px = 4.0;  ///< a press and release closer than
 constexpr double kPickRadius_px = 8.0;      ///< how near a draggable point a press must be to grab it
 constexpr double kPointRadius_px = 5.0;     ///< drawn radius of an overlay point
 
-/// The q-quantile (0..1) of up to ~65k evenly spread finite values of `values`.
-double quantile(const std::vector<float>& values, double q) {
+}  // namespace
+
+double ImageViewWidget::quantile(const std::vector<float>& values, double q) {
   const std::size_t step = std::max<std::size_t>(1, values.size() / 65536);
   std::vector<float> sample;
   sample.reserve(values.size() / step + 1);
@@ -25,12 +26,10 @@ double quantile(const std::vector<float>& values, double q) {
     if (std::isfinite(values[i])) sample.push_back(values[i]);
   }
   if (sample.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(sample.size() - 1));
+  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(sample.size() - 1));
   std::nth_element(sample.begin(), sample.begin() + static_cast<std::ptrdiff_t>(k), sample.end());
   return sample[k];
 }
-
-}  // namespace
 
 ImageViewWidget::ImageViewWidget(QWidget* parent) : QWidget(parent) {
   setMouseTracking(true);

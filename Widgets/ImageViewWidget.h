@@ -58,6 +58,8 @@ class ImageViewWidget : public QWidget {
   double level() const { return m_level; }
   /// The robust window/level of the image (1st-99th percentile of its values).
   void resetWindowLevel();
+  /// The q-quantile (0..1) of up to ~65k evenly spread finite values of `values` (0 when there are none).
+  static double quantile(const std::vector<float>& values, double q);
 
   /// Zoom factor relative to "fit" (1 = the whole image fits the view).
   void setZoom(double zoom);

@@ -187,6 +187,7 @@ void StudioDocument::setXrayWindow(const std::string& viewName, const DisplayWin
   const auto found = m_xrayWindows.find(viewName);
   if (found != m_xrayWindows.end() && found->second == window) return;
   m_xrayWindows[viewName] = window;
+  emit xrayWindowsChanged();
   touch();
 }
 

@@ -202,7 +202,7 @@ class StudioDocument : public QObject {
   // --- Display ---------------------------------------------------------------------------------------------------
   /// The window/level of each X-ray view the user set or that was read from the session, by view name.
   const std::map<std::string, DisplayWindow>& xrayWindows() const { return m_xrayWindows; }
-  /// Records view `viewName`'s window/level (saved in the session); emits changed() when it differs.
+  /// Records view `viewName`'s window/level (saved in the session); emits xrayWindowsChanged() when it differs.
   void setXrayWindow(const std::string& viewName, const DisplayWindow& window);
 
   /// True when the document holds work derived from its inputs (landmarks, an initial pose or results), which
@@ -238,6 +238,8 @@ class StudioDocument : public QObject {
   void resultChanged();
   /// The ground truth was set or cleared.
   void truthPoseChanged();
+  /// An X-ray view's recorded window/level changed.
+  void xrayWindowsChanged();
   /// Emitted after any change of the content (for autosave and the title bar).
   void changed();
   /// The document became modified (true) or saved (false).

@@ -121,6 +121,13 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
     for (SliceViewWidget* slice : m_sliceViews) slice->setVolume(m_document->ct());
   });
   connect(m_document, &StudioDocument::viewsChanged, this, &StudioMainWindow::rebuildXrayViews);
+  connect(m_document, &StudioDocument::xrayWindowsChanged, this, [this] {
+    const auto& views = m_document->views();
+    for (std::size_t v = 0; v < m_xrayViews.size() && v < views.size(); ++v) {
+      const auto saved = m_document->xrayWindows().find(views[v].name);
+      if (saved != m_document->xrayWindows().end()) m_xrayViews[v]->setWindowLevel(saved->second.window, saved->second.level);
+    }
+  });
   connect(m_document, &StudioDocument::modifiedChanged, this, &StudioMainWindow::updateTitle);
   connect(m_autosave, &SessionAutosave::failed, this, [this](const QString& message) {
     showStatus(tr("Autosave failed: %1").arg(message));
@@ -221,6 +228,13 @@ void StudioMainWindow::buildMenus() {
   view->addAction(tr("CT window: &soft tissue"), this, [this] {
     for (SliceViewWidget* slice : m_sliceViews) slice->applyWindowPreset(SliceWindowPreset::SoftTissue);
   });
+  for (const XrayWindowPreset preset :
+       {XrayWindowPreset::Automatic, XrayWindowPreset::WholeField, XrayWindowPreset::FullRange}) {
+    view->addAction(tr("X-ray window: %1").arg(XrayViewWidget::presetName(preset)), this, [this, preset] {
+      for (XrayViewWidget* xray : m_xrayViews) xray->applyWindowPreset(preset);
+    });
+  }
+  view->addSeparator();
   view->addAction(tr("&Reset views"), this, [this] {
     for (SliceViewWidget* slice : m_sliceViews) slice->resetView();
     for (XrayViewWidget* xray : m_xrayViews) xray->resetView();
@@ -248,6 +262,12 @@ void StudioMainWindow::rebuildXrayViews() {
     auto* widget = new XrayViewWidget(m_xrayRow);
     widget->setTitle(QString::fromStdString(view.name));
     widget->setImage(view.xray);
+    if (const auto saved = m_document->xrayWindows().find(view.name); saved != m_document->xrayWindows().end()) {
+      widget->setWindowLevel(saved->second.window, saved->second.level);
+    }
+    connect(widget, &ImageViewWidget::windowLevelChanged, this, [this, name = view.name](double window, double level) {
+      m_document->setXrayWindow(name, {window, level});
+    });
     const QString name = QString::fromStdString(view.name);
     connect(widget, &ImageViewWidget::pixelHovered, this, [this, name](const Eigen::Vector2d& uv, float value) {
       m_hover->setText(tr("%1: pixel (%2, %3)  value %4").arg(name).arg(uv.x(), 0, 'f', 1).arg(uv.y(), 0, 'f', 1).arg(value));

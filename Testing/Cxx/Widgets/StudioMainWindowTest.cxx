@@ -145,6 +145,40 @@ TEST_F(StudioMainWindowTest, SliceTitleAndReadoutGiveTheSamePatientSideInLps) {
   EXPECT_EQ(fct::SliceViewWidget::sideCoordinate(2, -0.01), QStringLiteral("S 0.0")) << "no signed zero";
 }
 
+TEST_F(StudioMainWindowTest, XraysOpenAtAReadableWindowAndTheUsersWindowIsSavedInTheSession) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  ASSERT_EQ(window.xrayViews().size(), 2u);
+  for (fct::XrayViewWidget* view : window.xrayViews()) {
+    // The built-in X-rays are 16-bit with a bright direct exposure; the window covers the patient only.
+    const auto& pixels = view->image().pixels;
+    const double range = fct::ImageViewWidget::quantile(pixels, 0.99) - fct::ImageViewWidget::quantile(pixels, 0.01);
+    EXPECT_LT(view->window(), 0.5 * range) << view->title().toStdString();
+    EXPECT_LT(view->level() + 0.5 * view->window(), fct::ImageViewWidget::quantile(pixels, 0.9));
+  }
+  EXPECT_TRUE(window.document()->xrayWindows().empty()) << "the automatic window is not a user setting";
+
+  // Ctrl-drag sets the window; it is saved and comes back with the session.
+  fct::XrayViewWidget* ap = window.xrayViews()[0];
+  QTest::mousePress(ap, Qt::LeftButton, Qt::ControlModifier, QPoint(100, 100));
+  QTest::mouseMove(ap, QPoint(160, 80));
+  QTest::mouseRelease(ap, Qt::LeftButton, Qt::ControlModifier, QPoint(160, 80));
+  const double userWindow = ap->window();
+  const double userLevel = ap->level();
+  ASSERT_EQ(window.document()->xrayWindows().count("ap"), 1u);
+  const QString path = QString::fromStdString((m_folder / "window.fctsession.json").string());
+  ASSERT_TRUE(window.saveSessionTo(path));
+  ASSERT_TRUE(window.newSession());
+  ASSERT_TRUE(window.openSession(path)) << window.lastMessage().toStdString();
+  ASSERT_EQ(window.xrayViews().size(), 2u);
+  EXPECT_DOUBLE_EQ(window.xrayViews()[0]->window(), userWindow);
+  EXPECT_DOUBLE_EQ(window.xrayViews()[0]->level(), userLevel);
+  EXPECT_FALSE(window.document()->isModified());
+}
+
 TEST_F(StudioMainWindowTest, AutosaveAppearsAfterAChangeAndIsRestoredAfterACrash) {
   const auto autosave = m_folder / "autosave.json";
   {
