@@ -268,47 +268,50 @@ void ImageViewWidget::paintEvent(QPaintEvent*) {
   painter.setRenderHint(QPainter::Antialiasing, true);
   const QPointF corner = imageCorner();
   auto toWidget = [&](const Eigen::Vector2d& uv) { return QPointF(corner.x() + s * (uv.x() + 0.5), corner.y() + s * (uv.y() + 0.5)); };
-  for (const Layer& l : m_layers) {
-    if (!l.visible) continue;
-    switch (l.kind) {
-      case LayerKind::Image:
-        painter.setOpacity(l.opacity);
-        painter.drawImage(target, l.image);
-        painter.setOpacity(1.0);
-        break;
-      case LayerKind::Polylines: {
-        painter.setOpacity(l.opacity);
-        painter.setPen(QPen(l.color, 1.6));
-        painter.setBrush(Qt::NoBrush);
-        for (const auto& polyline : l.polylines) {
-          if (polyline.size() < 2) continue;
-          QPainterPath path(toWidget(polyline.front()));
-          for (std::size_t i = 1; i < polyline.size(); ++i) path.lineTo(toWidget(polyline[i]));
-          if (l.closed) path.closeSubpath();
-          painter.drawPath(path);
-        }
-        painter.setOpacity(1.0);
-        break;
-      }
-      case LayerKind::Points:
-        for (const OverlayPoint& point : l.points) {
-          const QPointF p = toWidget(point.uv_px);
-          painter.setPen(QPen(QColor(0, 0, 0, 160), 3.0));
+  // Images (masks, DRR blends) first, then outlines, then points: an outline is never hidden under an image layer.
+  for (const LayerKind pass : {LayerKind::Image, LayerKind::Polylines, LayerKind::Points}) {
+    for (const Layer& l : m_layers) {
+      if (!l.visible || l.kind != pass) continue;
+      switch (l.kind) {
+        case LayerKind::Image:
+          painter.setOpacity(l.opacity);
+          painter.drawImage(target, l.image);
+          painter.setOpacity(1.0);
+          break;
+        case LayerKind::Polylines: {
+          painter.setOpacity(l.opacity);
+          painter.setPen(QPen(l.color, 1.6));
           painter.setBrush(Qt::NoBrush);
-          painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
-          painter.setPen(QPen(point.color, 1.6));
-          painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
-          painter.drawLine(p - QPointF(2, 0), p + QPointF(2, 0));
-          painter.drawLine(p - QPointF(0, 2), p + QPointF(0, 2));
-          if (!point.label.isEmpty()) {
-            const QPointF at = p + QPointF(kPointRadius_px + 3, -kPointRadius_px);
-            painter.setPen(QColor(0, 0, 0, 200));
-            painter.drawText(at + QPointF(1, 1), point.label);
-            painter.setPen(point.color);
-            painter.drawText(at, point.label);
+          for (const auto& polyline : l.polylines) {
+            if (polyline.size() < 2) continue;
+            QPainterPath path(toWidget(polyline.front()));
+            for (std::size_t i = 1; i < polyline.size(); ++i) path.lineTo(toWidget(polyline[i]));
+            if (l.closed) path.closeSubpath();
+            painter.drawPath(path);
           }
+          painter.setOpacity(1.0);
+          break;
         }
-        break;
+        case LayerKind::Points:
+          for (const OverlayPoint& point : l.points) {
+            const QPointF p = toWidget(point.uv_px);
+            painter.setPen(QPen(QColor(0, 0, 0, 160), 3.0));
+            painter.setBrush(Qt::NoBrush);
+            painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
+            painter.setPen(QPen(point.color, 1.6));
+            painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
+            painter.drawLine(p - QPointF(2, 0), p + QPointF(2, 0));
+            painter.drawLine(p - QPointF(0, 2), p + QPointF(0, 2));
+            if (!point.label.isEmpty()) {
+              const QPointF at = p + QPointF(kPointRadius_px + 3, -kPointRadius_px);
+              painter.setPen(QColor(0, 0, 0, 200));
+              painter.drawText(at + QPointF(1, 1), point.label);
+              painter.setPen(point.color);
+              painter.drawText(at, point.label);
+            }
+          }
+          break;
+      }
     }
   }
   painter.setRenderHint(QPainter::Antialiasing, false);

@@ -1,7 +1,7 @@
 #pragma once
 // ImageViewWidget: one 2D float image (an X-ray, a DRR, a CT slice) as grey levels with window/level, zoom and pan,
 // and named overlay layers drawn over it in image pixels: points with labels (optionally draggable), polylines (contours) and ARGB images
-// (ROI masks, DRR blends). Plain Qt painting. Mouse: wheel zooms about the cursor, middle or right drag pans,
+// (ROI masks, DRR blends). Image layers are drawn first, then polylines, then points (each kind in creation order). Plain Qt painting. Mouse: wheel zooms about the cursor, middle or right drag pans,
 // ctrl + left drag changes window (horizontal) and level (vertical), left click emits pixelClicked, left drag of a
 // draggable point emits pointDragged. Pixel (col,row) = (0,0) is the centre of the top-left pixel.
 
@@ -152,7 +152,7 @@ class ImageViewWidget : public QWidget {
   double m_level = 0.5;
   double m_zoom = 1.0;
   QPointF m_pan{0.0, 0.0};
-  std::vector<Layer> m_layers;  ///< in drawing order (first created, first drawn)
+  std::vector<Layer> m_layers;  ///< in creation order (drawn first within its kind)
 
   DragMode m_drag = DragMode::None;
   QPointF m_pressPos;

@@ -99,3 +99,33 @@ TEST(ReviewStepWidget, WithoutAResultExportIsRefusedWithAMessage) {
   step.acceptResult();
   EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided);
 }
+
+TEST(ReviewStepWidget, OutlinesAreDrawnOverTheCheckerboardAndTheBlend) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  session.document.addResult(resultAt(session, session.T_truth));
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  step.setShowInitial(false);
+  step.setContourColours(QColor(255, 0, 255), QColor(255, 0, 255));  // a colour neither the X-ray nor the DRR has
+  fct::XrayViewWidget* view = session.xrayViews[0];
+  const auto magentaPixels = [view] {
+    const QImage shot = view->grab().toImage();
+    int count = 0;
+    for (int y = 0; y < shot.height(); ++y) {
+      for (int x = 0; x < shot.width(); ++x) {
+        const QColor c = shot.pixelColor(x, y);
+        if (c.red() > 200 && c.blue() > 200 && c.green() < 80) ++count;
+      }
+    }
+    return count;
+  };
+  const int alone = magentaPixels();
+  ASSERT_GT(alone, 50) << "the final outline is drawn";
+  for (const auto mode : {fct::ReviewStepWidget::DrrMode::Checkerboard, fct::ReviewStepWidget::DrrMode::Blend}) {
+    step.setDrrMode(mode);
+    step.setDrrOpacity(1.0);
+    ASSERT_TRUE(view->isLayerVisible(fct::ReviewStepWidget::kDrrLayer));
+    EXPECT_GT(magentaPixels(), alone * 9 / 10) << "the outline stays on top of the DRR";
+  }
+}
