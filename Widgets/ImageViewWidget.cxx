@@ -349,7 +349,7 @@ void ImageViewWidget::mousePressEvent(QMouseEvent* event) {
     m_pressLevel = m_level;
   } else if (event->button() == Qt::LeftButton) {
     if (const auto picked = pickPoint(event->position())) {
-      m_drag = DragMode::Point;
+      m_drag = DragMode::PointPressed;
       m_dragPoint = *picked;
     } else {
       m_drag = DragMode::Click;
@@ -389,6 +389,12 @@ void ImageViewWidget::mouseMoveEvent(QMouseEvent* event) {
       setWindowLevel(m_pressWindow * std::exp(moved.x() / 200.0), m_pressLevel - moved.y() * unit);
       break;
     }
+    case DragMode::PointPressed: {
+      const QPointF moved = pos - m_pressPos;
+      if (std::hypot(moved.x(), moved.y()) <= kClickTolerance_px) break;
+      m_drag = DragMode::Point;
+      [[fallthrough]];
+    }
     case DragMode::Point: {
       Layer& l = m_layers[static_cast<std::size_t>(m_dragPoint.first)];
       const Eigen::Vector2d uv = pixelForWidgetPoint(pos);
@@ -409,6 +415,8 @@ void ImageViewWidget::mouseReleaseEvent(QMouseEvent* event) {
     const Eigen::Vector2d uv = pixelForWidgetPoint(event->position());
     const bool inside = uv.x() >= -0.5 && uv.y() >= -0.5 && uv.x() < m_image.cols - 0.5 && uv.y() < m_image.rows - 0.5;
     if (inside) emit pixelClicked(uv);
+  } else if (mode == DragMode::PointPressed) {
+    emit markerClicked(m_layers[static_cast<std::size_t>(m_dragPoint.first)].name, m_dragPoint.second);
   } else if (mode == DragMode::Point) {
     const QPointF moved = event->position() - m_pressPos;
     if (std::hypot(moved.x(), moved.y()) > 0.0) {

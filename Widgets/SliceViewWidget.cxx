@@ -68,6 +68,12 @@ SliceViewWidget::SliceViewWidget(SliceOrientation orientation, QWidget* parent)
   connect(this, &ImageViewWidget::pixelHovered, this, [this](const Eigen::Vector2d& uv_px, float value) {
     if (m_ct) emit ctPointHovered(ctPointForPixel(uv_px), value);
   });
+  connect(this, &ImageViewWidget::markerClicked, this, [this](const QString& layer, int index) {
+    for (const CtLayer& l : m_ctLayers) {
+      if (QStringLiteral("ct:") + l.name != layer || index < 0 || index >= static_cast<int>(l.shownIndex.size())) continue;
+      emit ctPointClicked(l.name, l.shownIndex[static_cast<std::size_t>(index)]);
+    }
+  });
   connect(this, &ImageViewWidget::pointDragged, this, [this](const QString& layer, int index, const Eigen::Vector2d& uv_px) {
     for (const CtLayer& l : m_ctLayers) {
       if (QStringLiteral("ct:") + l.name != layer || index < 0 || index >= static_cast<int>(l.shownIndex.size())) continue;

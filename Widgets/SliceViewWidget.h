@@ -81,6 +81,8 @@ class SliceViewWidget : public ImageViewWidget {
   void pointClicked(const Eigen::Vector3d& p_ct_mm);
   /// The user scrolled the slice; the crosshair is now at p_ct_mm (for linking the other views).
   void crosshairMoved(const Eigen::Vector3d& p_ct_mm);
+  /// A draggable CT point was clicked without moving it (index into the layer's points).
+  void ctPointClicked(const QString& layer, int index);
   /// A draggable CT point was moved to p_ct_mm (in the slice plane).
   void ctPointDragged(const QString& layer, int index, const Eigen::Vector3d& p_ct_mm);
   /// The CT point and value (HU) under the cursor.
