@@ -57,6 +57,12 @@ class RegisterStepWidget : public QWidget {
   QString message() const;
   /// The log text.
   QString logText() const;
+  /// The progress line under the bar, as shown.
+  QString progressText() const;
+  /// A preset stage's name in words for the progress line and log: "whole" stages are the coarse alignment on whole
+  /// images, a 1:1 ROI stage the final one at full resolution, other ROI stages the refinement on bone edges; the
+  /// preset's own name is kept in brackets ("Refinement (bone edges, 1:4) [vlnc-rois-1:4]").
+  static QString plainStageName(const std::string& stage);
 
  public slots:
   /// Starts a registration; false (with the reason shown) when one runs already or the CT, views, initial pose,
@@ -68,6 +74,8 @@ class RegisterStepWidget : public QWidget {
  signals:
   /// A run started (true) or ended (false).
   void runningChanged(bool running);
+  /// The step's message changed (for the status line).
+  void statusMessage(const QString& message);
 
  private:
   void onProgress(const RegistrationProgress& progress);
@@ -82,6 +90,11 @@ class RegisterStepWidget : public QWidget {
   /// Writes the controls' options into the document.
   void pushOptions();
   void appendLog(const QString& line);
+  /// Appends one line per stage of `result` to the log.
+  void logStages(const RegistrationResult& result);
+  /// When no run of this step is shown (e.g. after a session was opened), shows the document's current result: its
+  /// summary, a full bar and its stages in the log.
+  void showDocumentResult();
   void showMessage(const QString& text, bool error);
 
   StudioDocument* m_document;
@@ -89,6 +102,7 @@ class RegisterStepWidget : public QWidget {
   RegistrationWorker* m_worker = nullptr;
   RegistrationProgress m_lastProgress;
   bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
+  bool m_ranHere = false;                 ///< a run of this widget is shown (not a result from the session)
 
   QComboBox* m_presetCombo;
   QSpinBox* m_seedSpin;

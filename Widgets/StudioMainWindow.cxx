@@ -158,7 +158,8 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   addStep(tr("Data"), m_dataStep);
   addStep(tr("Initial pose"), new LandmarkStepWidget(m_document, this));
   addStep(tr("ROIs"), new RoiStepWidget(m_document, this));
-  addStep(tr("Register"), new RegisterStepWidget(m_document, this));
+  auto* registration = addStep(tr("Register"), new RegisterStepWidget(m_document, this));
+  connect(registration, &RegisterStepWidget::statusMessage, this, &StudioMainWindow::showStatus);
   addStep(tr("Review"), new ReviewStepWidget(m_document, this));
 
   buildMenus();

@@ -3,6 +3,8 @@
 // missing initial pose is refused with a message.
 #include <gtest/gtest.h>
 
+#include <QSignalSpy>
+
 #include "Evaluation/PoseOffset.h"
 #include "StepTestSession.h"
 #include "Widgets/RegisterStepWidget.h"
@@ -34,6 +36,7 @@ TEST(RegisterStepWidget, FastRunOnItsThreadEndsWithinOneMillimetre) {
   std::printf("fast registration from 5 mm via the Register step: %.3f mm, %ld DRRs\n", error_mm, result.totalDrrs);
   EXPECT_LT(error_mm, 1.0);
   EXPECT_NE(step.logText().indexOf(QStringLiteral("Registered")), -1);
+  EXPECT_NE(step.logText().indexOf(QStringLiteral("Coarse alignment (whole images)")), -1) << "stages in words";
 }
 
 TEST(RegisterStepWidget, CancelMidRunKeepsTheBestPoseMarkedAndTheWidgetRunsAgain) {
@@ -116,4 +119,19 @@ TEST(RegisterStepWidget, EveryAblationSwitchIncludingTheTransgraphRoundTrips) {
   onlyTransgraphOff.noTransgraph = true;
   step.setAblation(onlyTransgraphOff);
   EXPECT_EQ(step.ablation().activeNames(), std::vector<std::string>{"no-transgraph"});
+}
+
+TEST(RegisterStepWidget, StagesHavePlainNamesAndMessagesReachTheStatusLine) {
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("ncc-whole-1:16"),
+            QStringLiteral("Coarse alignment (whole images) [ncc-whole-1:16]"));
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("vlnc-rois-1:4"),
+            QStringLiteral("Refinement (bone edges, 1:4) [vlnc-rois-1:4]"));
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("vlnc-rois-1:1"), QStringLiteral("Final (full resolution) [vlnc-rois-1:1]"));
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("custom"), QStringLiteral("Refinement (bone edges) [custom]"));
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  QSignalSpy status(&step, &fct::RegisterStepWidget::statusMessage);
+  step.setActive(true);
+  ASSERT_EQ(status.count(), 1);
+  EXPECT_TRUE(status.at(0).at(0).toString().startsWith(QStringLiteral("No initial pose"))) << "the status line follows";
 }

@@ -2,6 +2,7 @@
 
 #include <QAbstractButton>
 #include <QComboBox>
+#include <QTableWidget>
 #include <QApplication>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -16,6 +17,8 @@
 #include "StudioTestCase.h"
 #include "TestSupport.h"
 #include "Widgets/DataStepWidget.h"
+#include "Widgets/LandmarkStepWidget.h"
+#include "Widgets/RegisterStepWidget.h"
 #include "Widgets/ReviewStepWidget.h"
 #include "Widgets/SessionAutosave.h"
 #include "Widgets/SliceViewWidget.h"
@@ -177,6 +180,57 @@ TEST_F(StudioMainWindowTest, XraysOpenAtAReadableWindowAndTheUsersWindowIsSavedI
   EXPECT_DOUBLE_EQ(window.xrayViews()[0]->window(), userWindow);
   EXPECT_DOUBLE_EQ(window.xrayViews()[0]->level(), userLevel);
   EXPECT_FALSE(window.document()->isModified());
+}
+
+TEST_F(StudioMainWindowTest, ReopeningASessionRestoresResidualsProjectedLandmarksAndTheRegisterState) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  fct::StudioDocument& document = *window.document();
+  ASSERT_TRUE(document.truthPose());
+  // Five landmarks spread over the phantom, clicked at their true projections in both views.
+  fct::Landmarks landmarks;
+  const Eigen::Vector3d centre = document.ct()->centre_lps_mm();
+  const std::vector<Eigen::Vector3d> offsets{{-20, -10, -15}, {20, -10, -10}, {0, 15, 0}, {-10, 5, 20}, {15, 10, 15}};
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    const std::string name = "L" + std::to_string(i + 1);
+    landmarks.ct.push_back({name, centre + offsets[i]});
+    for (const fct::RegistrationView& view : document.views()) {
+      landmarks.imageByView[view.name].push_back({name, view.camera.project(*document.truthPose() * (centre + offsets[i]))});
+    }
+  }
+  document.setLandmarks(landmarks);
+  auto* landmarkStep = window.findChild<fct::LandmarkStepWidget*>();
+  auto* registerStep = window.findChild<fct::RegisterStepWidget*>();
+  ASSERT_TRUE(landmarkStep && registerStep);
+  ASSERT_TRUE(landmarkStep->computePose()) << landmarkStep->message().toStdString();
+  fct::RegistrationResult result;
+  result.T_initial = *document.initialPose();
+  result.T_world_from_ct = *document.truthPose();
+  result.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  result.totalDrrs = 321;
+  fct::StageReport stage;
+  stage.name = "vlnc-rois-1:1";
+  result.stages.push_back(stage);
+  document.addResult(result);
+  const QString path = QString::fromStdString((m_folder / "restored.fctsession.json").string());
+  ASSERT_TRUE(window.saveSessionTo(path));
+  ASSERT_TRUE(window.newSession());
+  EXPECT_EQ(registerStep->progressText(), QStringLiteral("Not started"));
+
+  ASSERT_TRUE(window.openSession(path)) << window.lastMessage().toStdString();
+  ASSERT_TRUE(landmarkStep->estimate().has_value()) << "the landmark estimate is made again";
+  EXPECT_TRUE(landmarkStep->table()->item(0, 3)->text().endsWith(QStringLiteral(" px")));
+  window.showStepNamed(QStringLiteral("initial-pose"));
+  for (fct::XrayViewWidget* view : window.xrayViews()) {
+    EXPECT_EQ(view->layerPoints(fct::LandmarkStepWidget::kProjectedLayer).size(), offsets.size());
+  }
+  EXPECT_EQ(registerStep->progressText(), QStringLiteral("Finished"));
+  EXPECT_TRUE(registerStep->logText().contains(QStringLiteral("Result 1 of 1"))) << registerStep->logText().toStdString();
+  EXPECT_TRUE(registerStep->logText().contains(QStringLiteral("Final (full resolution)")));
+  EXPECT_EQ(document.result()->totalDrrs, 321);
 }
 
 TEST_F(StudioMainWindowTest, AutosaveAppearsAfterAChangeAndIsRestoredAfterACrash) {
