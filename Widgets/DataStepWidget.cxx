@@ -87,9 +87,11 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   viewButtons->addWidget(m_addXrays);
   viewLayout->addLayout(viewButtons);
   m_viewTable = new QTableWidget(0, 5, viewBox);
-  m_viewTable->setHorizontalHeaderLabels({tr("View"), tr("Image"), tr("Pixels"), tr("Type"), tr("SID mm")});
+  m_viewTable->setHorizontalHeaderLabels({tr("View"), tr("Image"), tr("Pixels"), tr("Type"), tr("SID (mm)")});
+  m_viewTable->horizontalHeaderItem(4)->setToolTip(tr("Source-to-detector distance of the view's camera, mm"));
   m_viewTable->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
-  m_viewTable->horizontalHeader()->setStretchLastSection(true);
+  m_viewTable->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);  // the file name gives way
+  m_viewTable->setTextElideMode(Qt::ElideMiddle);
   m_viewTable->verticalHeader()->hide();
   m_viewTable->setEditTriggers(QAbstractItemView::NoEditTriggers);
   m_viewTable->setSelectionMode(QAbstractItemView::NoSelection);
@@ -147,6 +149,7 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   connect(document, &StudioDocument::ctChanged, this, &DataStepWidget::refreshSummary);
   connect(document, &StudioDocument::viewsChanged, this, &DataStepWidget::refreshSummary);
   connect(document, &StudioDocument::truthPoseChanged, this, &DataStepWidget::refreshSummary);
+  connect(document, &StudioDocument::initialPoseChanged, this, &DataStepWidget::refreshSummary);
   refreshSummary();
 }
 
@@ -407,6 +410,9 @@ void DataStepWidget::refreshSummary() {
     if (m_document->truthPose()) {
       viewText += tr("<br>Ground truth pose known (simulated case):<br>the Review step shows the error against it.");
     }
+    viewText += m_document->initialPose()
+                    ? tr("<br>Initial pose from %1.").arg(m_document->initialPoseSource().toHtmlEscaped())
+                    : tr("<br>No initial pose yet: set one in the Initial pose step.");
   }
   m_viewSummary->setText(viewText);
   m_warnings->setText(warningList(m_document->ctWarnings(), tr("CT warnings")) +

@@ -642,11 +642,11 @@ void LandmarkStepWidget::loadWithDialog() {
 }
 
 void LandmarkStepWidget::saveWithDialog() {
-  const QString ctPath = QFileDialog::getSaveFileName(this, tr("Save CT landmarks"), QStringLiteral("landmarks.mrk.json"),
+  const QString ctPath = QFileDialog::getSaveFileName(this, tr("Save CT landmarks"), m_document->suggestedPath(QStringLiteral("landmarks.mrk.json")),
                                                       tr("Slicer markups (*.mrk.json)"));
   if (ctPath.isEmpty()) return;
   const QString imagePath = QFileDialog::getSaveFileName(this, tr("Save X-ray landmarks (cancel for none)"),
-                                                         QStringLiteral("landmarks_xray.json"),
+                                                         m_document->suggestedPath(QStringLiteral("landmarks_xray.json")),
                                                          tr("X-ray landmarks (*.json)"));
   saveLandmarks(ctPath, imagePath);
 }

@@ -94,12 +94,16 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   connect(m_methodCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_document, &StudioDocument::registrationOptionsChanged, this, &RegisterStepWidget::syncControls);
   connect(m_document, &StudioDocument::resultChanged, this, &RegisterStepWidget::showDocumentResult);
+  for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged, &StudioDocument::initialPoseChanged}) {
+    connect(m_document, signal, this, &RegisterStepWidget::updateRunButton);
+  }
   for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged}) {
     connect(m_document, signal, this, [this] {
       if (m_thread) m_inputsChangedDuringRun = true;
     });
   }
   syncControls();
+  updateRunButton();
 }
 
 RegisterStepWidget::~RegisterStepWidget() {
@@ -150,6 +154,21 @@ QString RegisterStepWidget::message() const { return m_message->text(); }
 QString RegisterStepWidget::logText() const { return m_log->toPlainText(); }
 
 QString RegisterStepWidget::progressText() const { return m_progressLabel->text(); }
+
+QString RegisterStepWidget::missingInputs() const {
+  QStringList missing;
+  if (!m_document->ct()) missing << tr("a CT (Data step)");
+  if (m_document->views().empty()) missing << tr("X-ray views (Data step)");
+  if (!m_document->initialPose()) missing << tr("an initial pose (Initial pose step: landmarks or the supine AP preset)");
+  return missing.join(QStringLiteral(", "));
+}
+
+void RegisterStepWidget::updateRunButton() {
+  const QString missing = missingInputs();
+  m_runButton->setEnabled(!m_thread && missing.isEmpty());
+  m_runButton->setToolTip(missing.isEmpty() ? tr("Register the CT to the X-rays from the initial pose")
+                                            : tr("Run needs %1").arg(missing));
+}
 
 QString RegisterStepWidget::plainStageName(const std::string& stage) {
   const QString name = QString::fromStdString(stage);
@@ -234,8 +253,8 @@ bool RegisterStepWidget::run() {
     return false;
   }
   const auto& initial = m_document->initialPose();
-  if (!initial) {
-    showMessage(tr("No initial pose: set one in the Initial pose step (landmarks or the supine AP preset)."), true);
+  if (const QString missing = missingInputs(); !missing.isEmpty()) {
+    showMessage(tr("Not ready to run: it needs %1.").arg(missing), true);
     return false;
   }
   const StudioRegistrationOptions& studioOptions = m_document->registrationOptions();
@@ -358,13 +377,13 @@ void RegisterStepWidget::endThread() {
 }
 
 void RegisterStepWidget::setRunningUi(bool running) {
-  m_runButton->setEnabled(!running);
   m_cancelButton->setEnabled(running);
   for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
                                                           m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
                                                           m_cmaesCheck, m_noTransgraphCheck, m_noCtPyramidCheck}) {
     control->setEnabled(!running);
   }
+  updateRunButton();
 }
 
 }  // namespace fct

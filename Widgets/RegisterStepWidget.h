@@ -57,6 +57,10 @@ class RegisterStepWidget : public QWidget {
   QString message() const;
   /// The log text.
   QString logText() const;
+  /// What Run still needs, in words ("a CT (Data step), an initial pose (Initial pose step)"); empty when ready.
+  QString missingInputs() const;
+  /// The Run button (disabled while inputs are missing, its tooltip naming them).
+  QPushButton* runButton() const { return m_runButton; }
   /// The progress line under the bar, as shown.
   QString progressText() const;
   /// A preset stage's name in words for the progress line and log: "whole" stages are the coarse alignment on whole
@@ -85,6 +89,8 @@ class RegisterStepWidget : public QWidget {
   void endThread();
   /// Enables the controls for the running state.
   void setRunningUi(bool running);
+  /// Enables Run when nothing runs and no input is missing; its tooltip says what is missing.
+  void updateRunButton();
   /// Copies the document's options into the controls.
   void syncControls();
   /// Writes the controls' options into the document.

@@ -177,12 +177,12 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
   connect(acceptButton, &QPushButton::clicked, this, &ReviewStepWidget::acceptResult);
   connect(rejectButton, &QPushButton::clicked, this, &ReviewStepWidget::rejectResult);
   connect(exportButton, &QPushButton::clicked, this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Export pose"), QStringLiteral("pose.tfm"),
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export pose"), m_document->suggestedPath(QStringLiteral("pose.tfm")),
                                                       tr("3D Slicer transform (*.tfm);;Pose JSON (*.json)"));
     if (!path.isEmpty()) exportPose(path);
   });
   connect(screenshotButton, &QPushButton::clicked, this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save screenshot"), QStringLiteral("review.png"),
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save screenshot"), m_document->suggestedPath(QStringLiteral("review.png")),
                                                       tr("PNG image (*.png)"));
     if (!path.isEmpty()) saveScreenshot(path);
   });

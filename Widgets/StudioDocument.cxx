@@ -179,6 +179,21 @@ void StudioDocument::dropPoseAndResults() {
   }
 }
 
+QString StudioDocument::suggestedPath(const QString& fileName) const {
+  fs::path folder;
+  if (!m_sessionPath.empty()) {
+    folder = m_sessionPath.parent_path();
+  } else if (!m_viewFilePath.empty()) {
+    folder = m_viewFilePath.parent_path();
+  } else if (!m_views.empty() && !m_views.front().xray.sourcePath.empty()) {
+    folder = fs::path(m_views.front().xray.sourcePath).parent_path();
+  } else if (!m_ctPath.empty()) {
+    folder = m_ctPath.parent_path();  // a DICOM folder's parent, too
+  }
+  if (folder.empty()) return fileName;
+  return QString::fromStdString((folder / fileName.toStdString()).string());
+}
+
 bool StudioDocument::hasDerivedState() const {
   return !m_landmarks.ct.empty() || !m_landmarks.imageByView.empty() || m_initialPose || !m_results.empty();
 }

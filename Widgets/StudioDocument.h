@@ -216,6 +216,9 @@ class StudioDocument : public QObject {
   void setModified(bool modified);
   /// The session file this document was last saved to or opened from (empty if none).
   const std::filesystem::path& sessionPath() const { return m_sessionPath; }
+  /// `fileName` in the case folder, where save and export dialogs start: the session file's folder, else the view
+  /// file's, else the first X-ray's, else the CT's (a bare file name, in the working folder, when there is none).
+  QString suggestedPath(const QString& fileName) const;
   /// Sets the session file path (does not save).
   void setSessionPath(std::filesystem::path path) { m_sessionPath = std::move(path); }
   /// Empties the document (new session): every part cleared, not modified, no session path. Emits every signal.

@@ -57,7 +57,7 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   panelLayout->addWidget(heading);
   m_steps = new QToolBox(panel);
   panelLayout->addWidget(m_steps, 1);
-  panel->setMinimumWidth(360);
+  panel->setMinimumWidth(400);  // the ROI spin boxes fit without a scrollbar
 
   // Views (right): X-rays on top; slices and 3D below.
   auto* viewArea = new QWidget(this);
@@ -110,7 +110,7 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   splitter->addWidget(panel);
   splitter->addWidget(viewArea);
   splitter->setStretchFactor(1, 1);
-  splitter->setSizes({380, 1120});
+  splitter->setSizes({420, 1080});
   setCentralWidget(splitter);
 
   m_hover = new QLabel(this);
@@ -338,7 +338,7 @@ bool StudioMainWindow::saveSession() {
 }
 
 bool StudioMainWindow::saveSessionAs() {
-  QString path = QFileDialog::getSaveFileName(this, tr("Save the session"), tr("session.fctsession.json"),
+  QString path = QFileDialog::getSaveFileName(this, tr("Save the session"), m_document->suggestedPath(tr("session.fctsession.json")),
                                               tr("FluoroCT sessions (*.fctsession.json)"));
   if (path.isEmpty()) return false;
   if (!path.endsWith(QStringLiteral(".json"))) path += QString::fromLatin1(StudioSession::kSuffix);

@@ -3,6 +3,7 @@
 // missing initial pose is refused with a message.
 #include <gtest/gtest.h>
 
+#include <QPushButton>
 #include <QSignalSpy>
 
 #include "Evaluation/PoseOffset.h"
@@ -134,4 +135,19 @@ TEST(RegisterStepWidget, StagesHavePlainNamesAndMessagesReachTheStatusLine) {
   step.setActive(true);
   ASSERT_EQ(status.count(), 1);
   EXPECT_TRUE(status.at(0).at(0).toString().startsWith(QStringLiteral("No initial pose"))) << "the status line follows";
+}
+
+TEST(RegisterStepWidget, RunIsDisabledWithoutDataAndItsTooltipSaysWhatIsMissing) {
+  fct::StudioDocument empty;
+  fct::RegisterStepWidget idle(&empty);
+  EXPECT_FALSE(idle.runButton()->isEnabled());
+  EXPECT_TRUE(idle.runButton()->toolTip().contains(QStringLiteral("a CT (Data step)"))) << idle.runButton()->toolTip().toStdString();
+  EXPECT_TRUE(idle.runButton()->toolTip().contains(QStringLiteral("an initial pose")));
+  EXPECT_FALSE(idle.run());
+  EXPECT_TRUE(idle.message().contains(QStringLiteral("X-ray views"))) << idle.message().toStdString();
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  EXPECT_FALSE(step.runButton()->isEnabled()) << "no initial pose yet";
+  setStartPose(session, 3.0);
+  EXPECT_TRUE(step.runButton()->isEnabled());
 }

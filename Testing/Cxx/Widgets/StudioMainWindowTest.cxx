@@ -277,6 +277,7 @@ TEST_F(StudioMainWindowTest, CloseAsksAboutUnsavedChangesAndCancelKeepsEverythin
   answerNextMessageBox(QMessageBox::Cancel, &question);
   EXPECT_FALSE(window.close());
   EXPECT_TRUE(question.contains(QStringLiteral("unsaved changes"))) << question.toStdString();
+  EXPECT_TRUE(question.contains(QStringLiteral("It holds nothing yet"))) << "says what is unsaved: " << question.toStdString();
   EXPECT_TRUE(window.isVisible());
   EXPECT_EQ(window.document()->registrationOptions().seed, 5u);
   EXPECT_TRUE(std::filesystem::exists(m_folder / "autosave.json"));
