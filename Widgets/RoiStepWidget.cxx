@@ -105,7 +105,8 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
   exclusionForm->addRow(tr("Image margin"), m_marginSpin);
   m_fieldOfViewCheck = new QCheckBox(tr("Exclude outside the collimator / field of view"), exclusionBox);
   exclusionForm->addRow(m_fieldOfViewCheck);
-  m_spheresCheck = new QCheckBox(tr("Detect calibration spheres (view-file spheres always excluded)"), exclusionBox);
+  m_spheresCheck = new QCheckBox(tr("Detect more calibration spheres"), exclusionBox);
+  m_spheresCheck->setToolTip(tr("The spheres listed in the view file are always excluded; this also finds others"));
   exclusionForm->addRow(m_spheresCheck);
   layout->addWidget(exclusionBox);
 
