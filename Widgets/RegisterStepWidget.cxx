@@ -292,6 +292,7 @@ bool RegisterStepWidget::run() {
   m_lastProgress = RegistrationProgress{};
   m_inputsChangedDuringRun = false;
   m_ranHere = true;
+  m_runTimer.start();
   m_worker = new RegistrationWorker(prepared.value(), *initial, std::move(options));
   m_thread = new QThread(this);
   m_worker->moveToThread(m_thread);
@@ -322,12 +323,19 @@ void RegisterStepWidget::onProgress(const RegistrationProgress& progress) {
   }
   m_lastProgress = progress;
   m_progressBar->setValue(static_cast<int>(1000.0 * progress.fraction));
-  m_progressLabel->setText(tr("Stage %1 of %2: %3 — %4 DRRs so far — image match %5 (higher is better)")
+  // Time left from the time so far and the run's fraction done (shown once a twentieth is done).
+  const double elapsed_s = 1e-3 * static_cast<double>(m_runTimer.elapsed());
+  const QString left = progress.fraction >= 0.05 && progress.fraction < 1.0
+                           ? tr(" — about %1 s left").arg(elapsed_s * (1.0 - progress.fraction) / progress.fraction, 0,
+                                                           'f', 0)
+                           : QString();
+  m_progressLabel->setText(tr("Stage %1 of %2: %3 — %4 DRRs so far — image match %5 (higher is better)%6")
                                .arg(progress.stageIndex + 1)
                                .arg(progress.stageCount)
                                .arg(plainStageName(progress.stage))
                                .arg(progress.drrs)
-                               .arg(progress.bestSimilarity, 0, 'f', 4));
+                               .arg(progress.bestSimilarity, 0, 'f', 4)
+                               .arg(left));
 }
 
 void RegisterStepWidget::onFinished(const RegistrationResult& result) {

@@ -7,6 +7,7 @@
 // views changed during the run (then it is reported and dropped); it becomes the current result unless the current one
 // is accepted, which only the user replaces (Review step).
 
+#include <QElapsedTimer>
 #include <QString>
 #include <QWidget>
 
@@ -109,6 +110,7 @@ class RegisterStepWidget : public QWidget {
   RegistrationProgress m_lastProgress;
   bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
   bool m_ranHere = false;                 ///< a run of this widget is shown (not a result from the session)
+  QElapsedTimer m_runTimer;               ///< since the current run started (for the time left)
 
   QComboBox* m_presetCombo;
   QSpinBox* m_seedSpin;
