@@ -2,6 +2,7 @@
 // truth, the verdict, and the exports (.tfm and JSON read back equal; screenshot PNG readable).
 #include <gtest/gtest.h>
 
+#include <QComboBox>
 #include <QImage>
 
 #include "Evaluation/PoseOffset.h"
@@ -128,4 +129,27 @@ TEST(ReviewStepWidget, OutlinesAreDrawnOverTheCheckerboardAndTheBlend) {
     ASSERT_TRUE(view->isLayerVisible(fct::ReviewStepWidget::kDrrLayer));
     EXPECT_GT(magentaPixels(), alone * 9 / 10) << "the outline stays on top of the DRR";
   }
+}
+
+TEST(ReviewStepWidget, TheHistoryKeepsTheAcceptedResultAndGoesBackToAnyRun) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  session.document.addResult(resultAt(session, session.T_truth));
+  step.acceptResult();
+  fct::RegistrationResult later = resultAt(session, session.T_truth);
+  later.cancelled = true;
+  EXPECT_FALSE(session.document.addResult(later)) << "a later run does not replace the accepted result";
+  QComboBox* history = step.historyChooser();
+  ASSERT_EQ(history->count(), 2);
+  EXPECT_EQ(history->currentIndex(), 0);
+  EXPECT_TRUE(history->itemText(0).contains(QStringLiteral("accepted"))) << history->itemText(0).toStdString();
+  EXPECT_TRUE(history->itemText(1).contains(QStringLiteral("cancelled"))) << history->itemText(1).toStdString();
+  emit history->activated(1);  // the user picks run 2 in the chooser
+  EXPECT_EQ(session.document.currentResultIndex(), 1);
+  EXPECT_TRUE(session.document.result()->cancelled);
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided);
+  emit history->activated(0);  // and back to the accepted one
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Accepted);
 }
