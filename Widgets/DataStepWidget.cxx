@@ -88,9 +88,11 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   viewButtons->addWidget(m_addXrays);
   viewLayout->addLayout(viewButtons);
   m_viewTable = new QTableWidget(0, 5, viewBox);
-  m_viewTable->setHorizontalHeaderLabels({tr("View"), tr("Image"), tr("Pixels"), tr("Type"), tr("SID mm")});
+  m_viewTable->setHorizontalHeaderLabels({tr("View"), tr("Image"), tr("Pixels"), tr("Type"), tr("SID (mm)")});
+  m_viewTable->horizontalHeaderItem(4)->setToolTip(tr("Source-to-detector distance of the view's camera, mm"));
   m_viewTable->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
-  m_viewTable->horizontalHeader()->setStretchLastSection(true);
+  m_viewTable->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);  // the file name gives way
+  m_viewTable->setTextElideMode(Qt::ElideMiddle);
   m_viewTable->verticalHeader()->hide();
   m_viewTable->setEditTriggers(QAbstractItemView::NoEditTriggers);
   m_viewTable->setSelectionMode(QAbstractItemView::NoSelection);
@@ -129,7 +131,9 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
         this, tr("Open a CT volume file"), {}, tr("Volumes (*.nii *.nii.gz *.nrrd *.nhdr *.mha *.mhd);;All files (*)"));
     if (!file.isEmpty()) openCt(file);
   });
-  connect(m_loadSeries, &QPushButton::clicked, this, &DataStepWidget::loadChosenSeries);
+  connect(m_loadSeries, &QPushButton::clicked, this, [this] {
+    if (mayChangeInputs()) loadChosenSeries();
+  });
   connect(m_openViews, &QPushButton::clicked, this, [this] {
     const QString file = QFileDialog::getOpenFileName(this, tr("Open a view file"), {},
                                                       tr("View files (*.json);;All files (*)"));
@@ -146,6 +150,7 @@ DataStepWidget::DataStepWidget(StudioDocument* document, QWidget* parent) : QWid
   connect(document, &StudioDocument::ctChanged, this, &DataStepWidget::refreshSummary);
   connect(document, &StudioDocument::viewsChanged, this, &DataStepWidget::refreshSummary);
   connect(document, &StudioDocument::truthPoseChanged, this, &DataStepWidget::refreshSummary);
+  connect(document, &StudioDocument::initialPoseChanged, this, &DataStepWidget::refreshSummary);
   refreshSummary();
 }
 
@@ -184,6 +189,8 @@ void DataStepWidget::setBusy(bool busy, const QString& what) {
   }
 }
 
+bool DataStepWidget::mayChangeInputs() const { return !m_busy && (!m_inputGuard || m_inputGuard()); }
+
 void DataStepWidget::reportError(const QString& what, const std::string& message) {
   const QString text = what + QStringLiteral(": ") + qs(message);
   m_error->setText(text);
@@ -198,7 +205,7 @@ void DataStepWidget::reportSuccess(const QString& message) {
 }
 
 void DataStepWidget::openCt(const QString& path) {
-  if (m_busy) return;
+  if (!mayChangeInputs()) return;
   const fs::path p = path.toStdString();
   std::error_code ec;
   if (!fs::is_directory(p, ec)) {
@@ -264,7 +271,7 @@ void DataStepWidget::loadChosenSeries() {
 }
 
 void DataStepWidget::openViewFile(const QString& path) {
-  if (m_busy) return;
+  if (!mayChangeInputs()) return;
   const fs::path p = path.toStdString();
   runInBackground<Result<LoadedViews>>(
       tr("Loading the views of %1…").arg(qs(p.filename())), [p] { return StudioDocument::readViews(p); },
@@ -278,7 +285,7 @@ void DataStepWidget::openViewFile(const QString& path) {
 }
 
 void DataStepWidget::addXrayFiles(const QStringList& paths) {
-  if (m_busy || paths.isEmpty()) return;
+  if (paths.isEmpty() || !mayChangeInputs()) return;
   std::vector<fs::path> files;
   for (const QString& path : paths) files.push_back(path.toStdString());
   using Views = Result<std::vector<RegistrationView>>;
@@ -330,7 +337,7 @@ Result<DataStepWidget::CaseFiles> DataStepWidget::findCaseFiles(const fs::path& 
 }
 
 void DataStepWidget::openCaseFolder(const QString& folder) {
-  if (m_busy) return;
+  if (!mayChangeInputs()) return;
   auto files = findCaseFiles(folder.toStdString());
   if (!files) return reportError(tr("Could not open the case folder"), files.error());
   const CaseFiles f = files.value();
@@ -352,6 +359,7 @@ void DataStepWidget::openCaseFolder(const QString& folder) {
       [this, folder](Result<LoadedCase>& loaded) {
         if (!loaded) return reportError(tr("Could not open the case folder"), loaded.error());
         LoadedCase& c = loaded.value();
+        m_document->setSessionPath({});  // another case: saving must not overwrite the old case's session file
         m_document->setCt(std::move(c.ct));
         m_document->setViews(std::move(c.views));
         if (c.initialPose) {
@@ -407,6 +415,9 @@ void DataStepWidget::refreshSummary() {
     if (m_document->truthPose()) {
       viewText += tr("<br>Ground truth pose known (simulated case):<br>the Review step shows the error against it.");
     }
+    viewText += m_document->initialPose()
+                    ? tr("<br>Initial pose from %1.").arg(m_document->initialPoseSource().toHtmlEscaped())
+                    : tr("<br>No initial pose yet: set one in the Initial pose step.");
   }
   m_viewSummary->setText(viewText);
   m_warnings->setText(warningList(m_document->ctWarnings(), tr("CT warnings")) +

@@ -2,7 +2,8 @@
 // DataStepWidget: the Data step of the workflow: open a CT (DICOM folder, choosing among its series, or a volume
 // file), a view file with its X-rays, views from the C-arm tags of X-ray DICOM files, or a whole case folder; show what
 // was loaded and any warnings in words. Loading runs on a worker thread with a busy bar; a failure shows the message
-// in the step (and the status line) and leaves the document as it was.
+// in the step (and the status line) and leaves the document as it was. Before a load replaces an input, the input
+// guard (set by the main window) may ask whether the work derived from the old inputs may go.
 
 #include <QString>
 #include <QStringList>
@@ -52,6 +53,10 @@ class DataStepWidget : public QWidget {
   };
   static Result<CaseFiles> findCaseFiles(const std::filesystem::path& folder);
 
+  /// Sets the function asked before any load that replaces or adds an input; a load goes on only if it returns true
+  /// (none set: always).
+  void setInputGuard(std::function<bool()> guard) { m_inputGuard = std::move(guard); }
+
  public slots:
   /// Opens a CT: a folder is scanned for DICOM series (one series is loaded at once; several are offered in the
   /// series chooser), a file is read as a volume. Runs in the background; loadFinished() reports the outcome.
@@ -79,6 +84,8 @@ class DataStepWidget : public QWidget {
   template <typename T>
   void runInBackground(const QString& what, std::function<T()> work, std::function<void(T&)> done);
   void setBusy(bool busy, const QString& what = {});
+  /// True when no load runs and the input guard lets the inputs change.
+  bool mayChangeInputs() const;
   /// Shows an error in the step and the status line and reports loadFinished(false).
   void reportError(const QString& what, const std::string& message);
   /// Reports success in the status line and loadFinished(true).
@@ -88,6 +95,7 @@ class DataStepWidget : public QWidget {
 
   StudioDocument* m_document;
   bool m_busy = false;
+  std::function<bool()> m_inputGuard;
   std::filesystem::path m_scannedFolder;
   std::vector<DicomSeriesSummary> m_series;
 

@@ -16,8 +16,9 @@ constexpr double kClickTolerance_px = 4.0;  ///< a press and release closer than
 constexpr double kPickRadius_px = 8.0;      ///< how near a draggable point a press must be to grab it
 constexpr double kPointRadius_px = 5.0;     ///< drawn radius of an overlay point
 
-/// The q-quantile (0..1) of up to ~65k evenly spread finite values of `values`.
-double quantile(const std::vector<float>& values, double q) {
+}  // namespace
+
+double ImageViewWidget::quantile(const std::vector<float>& values, double q) {
   const std::size_t step = std::max<std::size_t>(1, values.size() / 65536);
   std::vector<float> sample;
   sample.reserve(values.size() / step + 1);
@@ -25,12 +26,10 @@ double quantile(const std::vector<float>& values, double q) {
     if (std::isfinite(values[i])) sample.push_back(values[i]);
   }
   if (sample.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(sample.size() - 1));
+  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(sample.size() - 1));
   std::nth_element(sample.begin(), sample.begin() + static_cast<std::ptrdiff_t>(k), sample.end());
   return sample[k];
 }
-
-}  // namespace
 
 ImageViewWidget::ImageViewWidget(QWidget* parent) : QWidget(parent) {
   setMouseTracking(true);
@@ -269,47 +268,50 @@ void ImageViewWidget::paintEvent(QPaintEvent*) {
   painter.setRenderHint(QPainter::Antialiasing, true);
   const QPointF corner = imageCorner();
   auto toWidget = [&](const Eigen::Vector2d& uv) { return QPointF(corner.x() + s * (uv.x() + 0.5), corner.y() + s * (uv.y() + 0.5)); };
-  for (const Layer& l : m_layers) {
-    if (!l.visible) continue;
-    switch (l.kind) {
-      case LayerKind::Image:
-        painter.setOpacity(l.opacity);
-        painter.drawImage(target, l.image);
-        painter.setOpacity(1.0);
-        break;
-      case LayerKind::Polylines: {
-        painter.setOpacity(l.opacity);
-        painter.setPen(QPen(l.color, 1.6));
-        painter.setBrush(Qt::NoBrush);
-        for (const auto& polyline : l.polylines) {
-          if (polyline.size() < 2) continue;
-          QPainterPath path(toWidget(polyline.front()));
-          for (std::size_t i = 1; i < polyline.size(); ++i) path.lineTo(toWidget(polyline[i]));
-          if (l.closed) path.closeSubpath();
-          painter.drawPath(path);
-        }
-        painter.setOpacity(1.0);
-        break;
-      }
-      case LayerKind::Points:
-        for (const OverlayPoint& point : l.points) {
-          const QPointF p = toWidget(point.uv_px);
-          painter.setPen(QPen(QColor(0, 0, 0, 160), 3.0));
+  // Images (masks, DRR blends) first, then outlines, then points: an outline is never hidden under an image layer.
+  for (const LayerKind pass : {LayerKind::Image, LayerKind::Polylines, LayerKind::Points}) {
+    for (const Layer& l : m_layers) {
+      if (!l.visible || l.kind != pass) continue;
+      switch (l.kind) {
+        case LayerKind::Image:
+          painter.setOpacity(l.opacity);
+          painter.drawImage(target, l.image);
+          painter.setOpacity(1.0);
+          break;
+        case LayerKind::Polylines: {
+          painter.setOpacity(l.opacity);
+          painter.setPen(QPen(l.color, 1.6));
           painter.setBrush(Qt::NoBrush);
-          painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
-          painter.setPen(QPen(point.color, 1.6));
-          painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
-          painter.drawLine(p - QPointF(2, 0), p + QPointF(2, 0));
-          painter.drawLine(p - QPointF(0, 2), p + QPointF(0, 2));
-          if (!point.label.isEmpty()) {
-            const QPointF at = p + QPointF(kPointRadius_px + 3, -kPointRadius_px);
-            painter.setPen(QColor(0, 0, 0, 200));
-            painter.drawText(at + QPointF(1, 1), point.label);
-            painter.setPen(point.color);
-            painter.drawText(at, point.label);
+          for (const auto& polyline : l.polylines) {
+            if (polyline.size() < 2) continue;
+            QPainterPath path(toWidget(polyline.front()));
+            for (std::size_t i = 1; i < polyline.size(); ++i) path.lineTo(toWidget(polyline[i]));
+            if (l.closed) path.closeSubpath();
+            painter.drawPath(path);
           }
+          painter.setOpacity(1.0);
+          break;
         }
-        break;
+        case LayerKind::Points:
+          for (const OverlayPoint& point : l.points) {
+            const QPointF p = toWidget(point.uv_px);
+            painter.setPen(QPen(QColor(0, 0, 0, 160), 3.0));
+            painter.setBrush(Qt::NoBrush);
+            painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
+            painter.setPen(QPen(point.color, 1.6));
+            painter.drawEllipse(p, kPointRadius_px, kPointRadius_px);
+            painter.drawLine(p - QPointF(2, 0), p + QPointF(2, 0));
+            painter.drawLine(p - QPointF(0, 2), p + QPointF(0, 2));
+            if (!point.label.isEmpty()) {
+              const QPointF at = p + QPointF(kPointRadius_px + 3, -kPointRadius_px);
+              painter.setPen(QColor(0, 0, 0, 200));
+              painter.drawText(at + QPointF(1, 1), point.label);
+              painter.setPen(point.color);
+              painter.drawText(at, point.label);
+            }
+          }
+          break;
+      }
     }
   }
   painter.setRenderHint(QPainter::Antialiasing, false);
@@ -347,7 +349,7 @@ void ImageViewWidget::mousePressEvent(QMouseEvent* event) {
     m_pressLevel = m_level;
   } else if (event->button() == Qt::LeftButton) {
     if (const auto picked = pickPoint(event->position())) {
-      m_drag = DragMode::Point;
+      m_drag = DragMode::PointPressed;
       m_dragPoint = *picked;
     } else {
       m_drag = DragMode::Click;
@@ -387,6 +389,12 @@ void ImageViewWidget::mouseMoveEvent(QMouseEvent* event) {
       setWindowLevel(m_pressWindow * std::exp(moved.x() / 200.0), m_pressLevel - moved.y() * unit);
       break;
     }
+    case DragMode::PointPressed: {
+      const QPointF moved = pos - m_pressPos;
+      if (std::hypot(moved.x(), moved.y()) <= kClickTolerance_px) break;
+      m_drag = DragMode::Point;
+      [[fallthrough]];
+    }
     case DragMode::Point: {
       Layer& l = m_layers[static_cast<std::size_t>(m_dragPoint.first)];
       const Eigen::Vector2d uv = pixelForWidgetPoint(pos);
@@ -407,6 +415,8 @@ void ImageViewWidget::mouseReleaseEvent(QMouseEvent* event) {
     const Eigen::Vector2d uv = pixelForWidgetPoint(event->position());
     const bool inside = uv.x() >= -0.5 && uv.y() >= -0.5 && uv.x() < m_image.cols - 0.5 && uv.y() < m_image.rows - 0.5;
     if (inside) emit pixelClicked(uv);
+  } else if (mode == DragMode::PointPressed) {
+    emit markerClicked(m_layers[static_cast<std::size_t>(m_dragPoint.first)].name, m_dragPoint.second);
   } else if (mode == DragMode::Point) {
     const QPointF moved = event->position() - m_pressPos;
     if (std::hypot(moved.x(), moved.y()) > 0.0) {

@@ -1,9 +1,10 @@
 #pragma once
 // ImageViewWidget: one 2D float image (an X-ray, a DRR, a CT slice) as grey levels with window/level, zoom and pan,
 // and named overlay layers drawn over it in image pixels: points with labels (optionally draggable), polylines (contours) and ARGB images
-// (ROI masks, DRR blends). Plain Qt painting. Mouse: wheel zooms about the cursor, middle or right drag pans,
+// (ROI masks, DRR blends). Image layers are drawn first, then polylines, then points (each kind in creation order). Plain Qt painting. Mouse: wheel zooms about the cursor, middle or right drag pans,
 // ctrl + left drag changes window (horizontal) and level (vertical), left click emits pixelClicked, left drag of a
-// draggable point emits pointDragged. Pixel (col,row) = (0,0) is the centre of the top-left pixel.
+// draggable point emits pointDragged, and a click on one emits markerClicked (a press that moves less than the click
+// tolerance never moves a point). Pixel (col,row) = (0,0) is the centre of the top-left pixel.
 
 #include <Eigen/Core>
 #include <QColor>
@@ -58,6 +59,8 @@ class ImageViewWidget : public QWidget {
   double level() const { return m_level; }
   /// The robust window/level of the image (1st-99th percentile of its values).
   void resetWindowLevel();
+  /// The q-quantile (0..1) of up to ~65k evenly spread finite values of `values` (0 when there are none).
+  static double quantile(const std::vector<float>& values, double q);
 
   /// Zoom factor relative to "fit" (1 = the whole image fits the view).
   void setZoom(double zoom);
@@ -98,7 +101,10 @@ class ImageViewWidget : public QWidget {
  signals:
   /// Left click (press and release without a drag) at an image pixel; only inside the image.
   void pixelClicked(const Eigen::Vector2d& uv_px);
-  /// A draggable point was dragged to uv_px (emitted while moving and on release).
+  /// A draggable point was pressed and released without moving beyond the click tolerance (it is not moved).
+  void markerClicked(const QString& layer, int index);
+  /// A draggable point was dragged to uv_px (emitted while moving and on release), once the press moved beyond the
+  /// click tolerance.
   void pointDragged(const QString& layer, int index, const Eigen::Vector2d& uv_px);
   /// The pixel under the cursor and its value (for a status line); emitted on mouse move inside the image.
   void pixelHovered(const Eigen::Vector2d& uv_px, float value);
@@ -128,7 +134,7 @@ class ImageViewWidget : public QWidget {
     double opacity = 1.0;
     QImage image;
   };
-  enum class DragMode { None, Click, Pan, WindowLevel, Point };
+  enum class DragMode { None, Click, Pan, WindowLevel, PointPressed, Point };
 
   Layer* findLayer(const QString& name);
   const Layer* findLayer(const QString& name) const;
@@ -150,7 +156,7 @@ class ImageViewWidget : public QWidget {
   double m_level = 0.5;
   double m_zoom = 1.0;
   QPointF m_pan{0.0, 0.0};
-  std::vector<Layer> m_layers;  ///< in drawing order (first created, first drawn)
+  std::vector<Layer> m_layers;  ///< in creation order (drawn first within its kind)
 
   DragMode m_drag = DragMode::None;
   QPointF m_pressPos;

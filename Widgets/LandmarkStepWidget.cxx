@@ -1,11 +1,15 @@
 #include "Widgets/LandmarkStepWidget.h"
 
+#include <QAction>
+#include <QEvent>
 #include <QFileDialog>
+#include <QMouseEvent>
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
 #include <QPushButton>
 #include <QTableWidget>
+#include <QUndoStack>
 #include <QVBoxLayout>
 #include <fmt/format.h>
 
@@ -16,6 +20,7 @@
 #include "Image/BoneSurface.h"
 #include "InitialPose/SetupPose.h"
 #include "IO/Project/LandmarkFile.h"
+#include "Widgets/LandmarkEditCommand.h"
 #include "Widgets/SliceViewWidget.h"
 #include "Widgets/StudioDocument.h"
 #include "Widgets/XrayViewWidget.h"
@@ -56,19 +61,29 @@ LandmarkStepWidget::LandmarkStepWidget(StudioDocument* document, QWidget* parent
     : QWidget(parent), m_document(document) {
   auto* layout = new QVBoxLayout(this);
   auto* help = new QLabel(tr("Click a point in a CT slice view to add a landmark, then click its partner in one or more "
-                             "X-ray views (drag to move it). At least 4 landmarks, not on one line."),
+                             "X-ray views (drag either to move it; Ctrl+Z undoes). ") + ruleText(),
                           this);
   help->setWordWrap(true);
   layout->addWidget(help);
 
   m_table = new QTableWidget(0, kColumnCount, this);
-  m_table->setHorizontalHeaderLabels({tr("Name"), tr("CT (LPS mm)"), tr("X-ray views"), tr("Residual (px)"),
-                                      tr("Residual (mm)")});
+  m_table->setHorizontalHeaderLabels({tr("Name"), tr("CT (LPS mm)"), tr("X-ray views"), tr("Reprojection"),
+                                      tr("3-D")});
+  m_table->horizontalHeaderItem(kResidualPx)->setToolTip(tr("Largest reprojection error over the landmark's views, "
+                                                            "pixels"));
+  m_table->horizontalHeaderItem(kResidualMm)->setToolTip(tr("Distance to the landmark triangulated from two or more "
+                                                            "views, mm"));
   m_table->setSelectionBehavior(QAbstractItemView::SelectRows);
   m_table->setSelectionMode(QAbstractItemView::SingleSelection);
+  m_table->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   m_table->horizontalHeader()->setStretchLastSection(true);
   m_table->verticalHeader()->setVisible(false);
+  m_table->setTextElideMode(Qt::ElideRight);
+  m_table->viewport()->installEventFilter(this);
   layout->addWidget(m_table, 1);
+  m_missing = new QLabel(this);
+  m_missing->setWordWrap(true);
+  layout->addWidget(m_missing);
 
   auto* editRow = new QHBoxLayout();
   m_deleteButton = new QPushButton(tr("Delete landmark"), this);
@@ -96,21 +111,37 @@ LandmarkStepWidget::LandmarkStepWidget(StudioDocument* document, QWidget* parent
   connect(m_table, &QTableWidget::currentCellChanged, this, [this](int row, int, int, int) {
     if (m_refreshing) return;
     m_selected = row >= 0 && m_table->item(row, kName) ? m_table->item(row, kName)->text() : QString();
+    jumpTo(m_selected);
     updateLayers();
   });
+  m_undo = new QUndoStack(this);
+  m_undoAction = new QAction(tr("Undo landmark edit"), this);
+  m_undoAction->setShortcut(QKeySequence::Undo);
+  m_redoAction = new QAction(tr("Redo landmark edit"), this);
+  m_redoAction->setShortcuts({QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_Z), QKeySequence::Redo});
+  for (QAction* action : {m_undoAction, m_redoAction}) {
+    action->setShortcutContext(Qt::WindowShortcut);
+    action->setEnabled(false);
+    addAction(action);
+  }
+  connect(m_undoAction, &QAction::triggered, this, &LandmarkStepWidget::undo);
+  connect(m_redoAction, &QAction::triggered, this, &LandmarkStepWidget::redo);
   connect(m_table, &QTableWidget::cellChanged, this, &LandmarkStepWidget::onItemChanged);
-  connect(m_deleteButton, &QPushButton::clicked, this, [this] { deleteLandmark(m_selected); });
+  connect(m_deleteButton, &QPushButton::clicked, this, [this] { deleteLandmark(QString(m_selected)); });
   connect(loadButton, &QPushButton::clicked, this, &LandmarkStepWidget::loadWithDialog);
   connect(saveButton, &QPushButton::clicked, this, &LandmarkStepWidget::saveWithDialog);
   connect(m_computeButton, &QPushButton::clicked, this, &LandmarkStepWidget::computePose);
   connect(presetButton, &QPushButton::clicked, this, &LandmarkStepWidget::applySetupPose);
-  // A pose estimate belongs to the landmarks and cameras it came from.
+  // A pose estimate belongs to the landmarks and cameras it came from; landmarks replaced from elsewhere (a session,
+  // new images) start a new undo history.
   for (auto signal : {&StudioDocument::landmarksChanged, &StudioDocument::viewsChanged}) {
     connect(m_document, signal, this, [this] {
       m_estimate.reset();
+      if (!m_editing) m_undo->clear();
       refresh();
     });
   }
+  connect(m_document, &StudioDocument::initialPoseChanged, this, &LandmarkStepWidget::restoreEstimate);
   refresh();
 }
 
@@ -126,17 +157,39 @@ void LandmarkStepWidget::setActive(bool active) {
   for (const QMetaObject::Connection& connection : m_viewConnections) disconnect(connection);
   m_viewConnections.clear();
   m_active = active;
+  m_undoAction->setEnabled(active && m_undo->canUndo());
+  m_redoAction->setEnabled(active && m_undo->canRedo());
   if (active) {
     for (SliceViewWidget* view : m_sliceViews) {
       if (!view) continue;
       m_viewConnections.push_back(
           connect(view, &SliceViewWidget::pointClicked, this, &LandmarkStepWidget::addCtLandmark));
+      m_viewConnections.push_back(connect(view, &SliceViewWidget::ctPointClicked, this, [this](const QString& layer, int index) {
+        const auto& ct = m_document->landmarks().ct;
+        if (layer == kClickLayer && index >= 0 && index < static_cast<int>(ct.size())) {
+          selectLandmark(QString::fromStdString(ct[static_cast<std::size_t>(index)].name));
+        }
+      }));
+      m_viewConnections.push_back(connect(
+          view, &SliceViewWidget::ctPointDragged, this, [this](const QString& layer, int index, const Eigen::Vector3d& p) {
+            const auto& ct = m_document->landmarks().ct;
+            if (layer == kClickLayer && index >= 0 && index < static_cast<int>(ct.size())) {
+              moveCtLandmark(QString::fromStdString(ct[static_cast<std::size_t>(index)].name), p);
+            }
+          }));
     }
     for (std::size_t v = 0; v < m_xrayViews.size(); ++v) {
       const int viewIndex = static_cast<int>(v);
       m_viewConnections.push_back(connect(m_xrayViews[v], &XrayViewWidget::pixelClicked, this,
                                           [this, viewIndex](const Eigen::Vector2d& uv_px) {
                                             setImagePoint(viewIndex, uv_px);
+                                          }));
+      m_viewConnections.push_back(connect(m_xrayViews[v], &XrayViewWidget::markerClicked, this,
+                                          [this, viewIndex](const QString& layer, int index) {
+                                            const auto& names = m_clickLayerNames[static_cast<std::size_t>(viewIndex)];
+                                            if (layer == kClickLayer && index >= 0 && index < static_cast<int>(names.size())) {
+                                              selectLandmark(names[static_cast<std::size_t>(index)]);
+                                            }
                                           }));
       m_viewConnections.push_back(
           connect(m_xrayViews[v], &XrayViewWidget::pointDragged, this,
@@ -146,6 +199,56 @@ void LandmarkStepWidget::setActive(bool active) {
     }
   }
   updateLayers();
+}
+
+QString LandmarkStepWidget::ruleText() {
+  return tr("A pose needs at least 4 landmarks, not on one line, each clicked in at least one X-ray view, and either 4 "
+            "of them clicked in the same view or 3 of them clicked in two views each.");
+}
+
+QString LandmarkStepWidget::missingText() const {
+  const Landmarks& landmarks = m_document->landmarks();
+  const auto clickedIn = [&landmarks](const std::string& view, const std::string& name) {
+    const auto found = landmarks.imageByView.find(view);
+    return found != landmarks.imageByView.end() &&
+           std::any_of(found->second.begin(), found->second.end(), [&](const ImageLandmark& p) { return p.name == name; });
+  };
+  QStringList todo;
+  const int count = static_cast<int>(landmarks.ct.size());
+  if (count < 4) todo << tr("add %n more landmark(s) in a CT slice view", nullptr, 4 - count);
+  QStringList unclicked;
+  int inTwoViews = 0;
+  for (const CtLandmark& landmark : landmarks.ct) {
+    int views = 0;
+    for (const RegistrationView& view : m_document->views()) views += clickedIn(view.name, landmark.name) ? 1 : 0;
+    if (views == 0) unclicked << QString::fromStdString(landmark.name);
+    if (views >= 2) ++inTwoViews;
+  }
+  if (!unclicked.isEmpty()) todo << tr("click %1 in an X-ray view (or delete it)").arg(unclicked.join(QStringLiteral(", ")));
+  int most = 0;
+  QString mostView;
+  QStringList perView;
+  for (const RegistrationView& view : m_document->views()) {
+    const int clicked = static_cast<int>(std::count_if(landmarks.ct.begin(), landmarks.ct.end(), [&](const CtLandmark& l) {
+      return clickedIn(view.name, l.name);
+    }));
+    perView << QStringLiteral("%1 %2").arg(QString::fromStdString(view.name)).arg(clicked);
+    if (clicked > most || mostView.isEmpty()) {
+      most = clicked;
+      mostView = QString::fromStdString(view.name);
+    }
+  }
+  if (!m_document->views().empty() && most < 4 && inTwoViews < 3) {
+    todo << tr("click %n more landmark(s) in view '%1' (it has %2 of the 4 one view needs)", nullptr, 4 - most)
+                .arg(mostView)
+                .arg(most) +
+                tr(", or %n more in a second view (%1 of 3 are clicked in two views)", nullptr, 3 - inTwoViews)
+                    .arg(inTwoViews);
+  }
+  if (todo.isEmpty()) return {};
+  QString text = todo.join(QStringLiteral("; ")) + QLatin1Char('.');
+  if (!perView.isEmpty()) text += tr(" Clicked per view: %1.").arg(perView.join(QStringLiteral(", ")));
+  return text;
 }
 
 QString LandmarkStepWidget::selectedLandmark() const { return m_selected; }
@@ -170,12 +273,9 @@ void LandmarkStepWidget::addCtLandmark(const Eigen::Vector3d& p_ct_mm) {
   }
   landmarks.ct.push_back(CtLandmark{name, p_ct_mm});
   m_selected = QString::fromStdString(name);
-  m_document->setLandmarks(std::move(landmarks));
-  showMessage(tr("Added %1 at (%2, %3, %4) mm; now click its partner in the X-ray views.")
-                  .arg(m_selected)
-                  .arg(p_ct_mm.x(), 0, 'f', 1)
-                  .arg(p_ct_mm.y(), 0, 'f', 1)
-                  .arg(p_ct_mm.z(), 0, 'f', 1),
+  commit(std::move(landmarks), tr("Add %1").arg(m_selected));
+  showMessage(tr("Added %1 at %2; now click its partner in the X-ray views.")
+                  .arg(m_selected, SliceViewWidget::positionText(p_ct_mm)),
               false);
 }
 
@@ -194,12 +294,15 @@ void LandmarkStepWidget::setImagePoint(int viewIndex, const Eigen::Vector2d& uv_
   const std::string name = m_selected.toStdString();
   std::vector<ImageLandmark>& points = landmarks.imageByView[views[static_cast<std::size_t>(viewIndex)].name];
   auto found = std::find_if(points.begin(), points.end(), [&](const ImageLandmark& p) { return p.name == name; });
-  if (found != points.end()) {
+  const QString viewName = QString::fromStdString(views[static_cast<std::size_t>(viewIndex)].name);
+  const bool moved = found != points.end();
+  if (moved) {
     found->uv_px = uv_px;
   } else {
     points.push_back(ImageLandmark{name, uv_px});
   }
-  m_document->setLandmarks(std::move(landmarks));
+  commit(std::move(landmarks), (moved ? tr("Move %1 in %2") : tr("Place %1 in %2")).arg(m_selected, viewName),
+         moved ? m_selected + QLatin1Char('@') + viewName : QString());
   showMessage(tr("%1 placed in view '%2' at (%3, %4) px.")
                   .arg(m_selected, QString::fromStdString(views[static_cast<std::size_t>(viewIndex)].name))
                   .arg(uv_px.x(), 0, 'f', 1)
@@ -232,7 +335,7 @@ bool LandmarkStepWidget::renameLandmark(const QString& oldName, const QString& n
     }
   }
   if (m_selected == oldName) m_selected = QString::fromStdString(to);
-  m_document->setLandmarks(std::move(landmarks));
+  commit(std::move(landmarks), tr("Rename %1 to %2").arg(oldName, QString::fromStdString(to)));
   return true;
 }
 
@@ -248,8 +351,78 @@ void LandmarkStepWidget::deleteLandmark(const QString& name) {
   for (auto& [view, points] : landmarks.imageByView) std::erase_if(points, named);
   std::erase_if(landmarks.imageByView, [](const auto& entry) { return entry.second.empty(); });
   if (m_selected == name) m_selected.clear();
-  m_document->setLandmarks(std::move(landmarks));
-  showMessage(tr("Deleted %1.").arg(name), false);
+  commit(std::move(landmarks), tr("Delete %1").arg(name));
+  showMessage(tr("Deleted %1 (Ctrl+Z brings it back).").arg(name), false);
+}
+
+void LandmarkStepWidget::moveCtLandmark(const QString& name, const Eigen::Vector3d& p_ct_mm) {
+  Landmarks landmarks = m_document->landmarks();
+  const std::string target = name.toStdString();
+  auto found = std::find_if(landmarks.ct.begin(), landmarks.ct.end(), [&](const CtLandmark& l) { return l.name == target; });
+  if (found == landmarks.ct.end() || !p_ct_mm.allFinite()) return;
+  found->p_ct_mm = p_ct_mm;
+  m_selected = name;
+  commit(std::move(landmarks), tr("Move %1 in the CT").arg(name), name + QStringLiteral("@ct"));
+  showMessage(tr("Moved %1 to %2.").arg(name, SliceViewWidget::positionText(p_ct_mm)), false);
+}
+
+void LandmarkStepWidget::commit(Landmarks landmarks, const QString& text, const QString& dragKey) {
+  m_editing = true;
+  m_undo->push(new LandmarkEditCommand(m_document, m_document->landmarks(), std::move(landmarks), text, dragKey));
+  m_editing = false;
+  m_undoAction->setEnabled(m_active && m_undo->canUndo());
+  m_redoAction->setEnabled(m_active && m_undo->canRedo());
+}
+
+void LandmarkStepWidget::undo() {
+  if (!m_undo->canUndo()) return;
+  const QString text = m_undo->undoText();
+  m_editing = true;
+  m_undo->undo();
+  m_editing = false;
+  m_undoAction->setEnabled(m_active && m_undo->canUndo());
+  m_redoAction->setEnabled(m_active && m_undo->canRedo());
+  showMessage(tr("Undid: %1.").arg(text), false);
+}
+
+void LandmarkStepWidget::redo() {
+  if (!m_undo->canRedo()) return;
+  const QString text = m_undo->redoText();
+  m_editing = true;
+  m_undo->redo();
+  m_editing = false;
+  m_undoAction->setEnabled(m_active && m_undo->canUndo());
+  m_redoAction->setEnabled(m_active && m_undo->canRedo());
+  showMessage(tr("Redid: %1.").arg(text), false);
+}
+
+void LandmarkStepWidget::jumpTo(const QString& name) {
+  const int row = rowOf(name);
+  if (row < 0) return;
+  const Eigen::Vector3d p_ct_mm = m_document->landmarks().ct[static_cast<std::size_t>(row)].p_ct_mm;
+  for (SliceViewWidget* view : m_sliceViews) {
+    if (view) view->setCrosshair_ct_mm(p_ct_mm);
+  }
+}
+
+bool LandmarkStepWidget::eventFilter(QObject* watched, QEvent* event) {
+  if (watched == m_table->viewport() && event->type() == QEvent::MouseButtonPress) {
+    const auto* press = static_cast<QMouseEvent*>(event);
+    if (!m_table->itemAt(press->position().toPoint())) {
+      selectLandmark({});
+      return true;
+    }
+  }
+  return QWidget::eventFilter(watched, event);
+}
+
+void LandmarkStepWidget::restoreEstimate() {
+  const auto& pose = m_document->initialPose();
+  if (m_estimate || !pose || !m_document->initialPoseSource().startsWith(QStringLiteral("landmarks"))) return;
+  auto estimate = LandmarkPoseEstimator::fromReprojection(m_document->landmarks(), camerasOf(*m_document));
+  if (!estimate || !estimate.value().T_world_from_ct.isApprox(*pose, 1e-6)) return;  // the landmarks moved since
+  m_estimate = std::move(estimate).value();
+  refresh();
 }
 
 bool LandmarkStepWidget::computePose() {
@@ -257,9 +430,15 @@ bool LandmarkStepWidget::computePose() {
     showMessage(tr("No X-ray views loaded: open a view file in the Data step first."), true);
     return false;
   }
+  if (const QString missing = missingText(); !missing.isEmpty()) {
+    showMessage(tr("Not enough clicks for a pose yet. To do: %1").arg(missing), true);
+    return false;
+  }
   auto estimate = LandmarkPoseEstimator::fromReprojection(m_document->landmarks(), camerasOf(*m_document));
   if (!estimate) {
-    showMessage(tr("Cannot compute the pose: %1").arg(QString::fromStdString(estimate.error())), true);
+    showMessage(tr("Cannot compute the pose: %1. Move or replace a landmark and compute again.")
+                    .arg(QString::fromStdString(estimate.error())),
+                true);
     return false;
   }
   m_estimate = std::move(estimate).value();
@@ -319,7 +498,7 @@ bool LandmarkStepWidget::loadLandmarks(const QString& ctPath, const QString& ima
   }
   m_selected.clear();
   const std::size_t count = landmarks.ct.size();
-  m_document->setLandmarks(std::move(landmarks));
+  commit(std::move(landmarks), tr("Load landmarks"));
   showMessage(tr("Loaded %1 CT landmarks.").arg(count), false);
   return true;
 }
@@ -375,8 +554,8 @@ void LandmarkStepWidget::refresh() {
         if (residual.name != landmark.name) continue;
         double worst_px = 0.0;
         for (const auto& [view, px] : residual.reprojection_px) worst_px = std::max(worst_px, px);
-        residualPx = QString::number(worst_px, 'f', 2);
-        if (std::isfinite(residual.distance_mm)) residualMm = QString::number(residual.distance_mm, 'f', 2);
+        residualPx = tr("%1 px").arg(worst_px, 0, 'f', 2);
+        if (std::isfinite(residual.distance_mm)) residualMm = tr("%1 mm").arg(residual.distance_mm, 0, 'f', 2);
       }
     }
     m_table->setItem(row, kResidualPx, readOnlyItem(residualPx));
@@ -389,6 +568,8 @@ void LandmarkStepWidget::refresh() {
     m_table->clearSelection();
   }
   m_deleteButton->setEnabled(!landmarks.ct.empty());
+  m_missing->setText(missingText().isEmpty() ? tr("Enough clicks for a pose: press Compute pose.")
+                                             : tr("Still to do: %1").arg(missingText()));
   m_refreshing = false;
   updateLayers();
 }
@@ -432,7 +613,7 @@ void LandmarkStepWidget::updateLayers() {
         points.push_back(SlicePoint{landmark.p_ct_mm, name, name == m_selected ? kSelectedColour : kClickColour});
       }
     }
-    sliceView->setCtPointLayer(kClickLayer, std::move(points));
+    sliceView->setCtPointLayer(kClickLayer, std::move(points), /*draggable=*/true);
   }
 }
 
@@ -461,11 +642,11 @@ void LandmarkStepWidget::loadWithDialog() {
 }
 
 void LandmarkStepWidget::saveWithDialog() {
-  const QString ctPath = QFileDialog::getSaveFileName(this, tr("Save CT landmarks"), QStringLiteral("landmarks.mrk.json"),
+  const QString ctPath = QFileDialog::getSaveFileName(this, tr("Save CT landmarks"), m_document->suggestedPath(QStringLiteral("landmarks.mrk.json")),
                                                       tr("Slicer markups (*.mrk.json)"));
   if (ctPath.isEmpty()) return;
   const QString imagePath = QFileDialog::getSaveFileName(this, tr("Save X-ray landmarks (cancel for none)"),
-                                                         QStringLiteral("landmarks_xray.json"),
+                                                         m_document->suggestedPath(QStringLiteral("landmarks_xray.json")),
                                                          tr("X-ray landmarks (*.json)"));
   saveLandmarks(ctPath, imagePath);
 }

@@ -76,6 +76,7 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   m_progressBar->setTextVisible(false);
   layout->addWidget(m_progressBar);
   m_progressLabel = new QLabel(tr("Not started"), this);
+  m_progressLabel->setWordWrap(true);  // a long stage line must not widen the panel and push Cancel out of sight
   layout->addWidget(m_progressLabel);
   m_message = new QLabel(this);
   m_message->setWordWrap(true);
@@ -92,12 +93,17 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   connect(m_seedSpin, &QSpinBox::valueChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_methodCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_document, &StudioDocument::registrationOptionsChanged, this, &RegisterStepWidget::syncControls);
+  connect(m_document, &StudioDocument::resultChanged, this, &RegisterStepWidget::showDocumentResult);
+  for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged, &StudioDocument::initialPoseChanged}) {
+    connect(m_document, signal, this, &RegisterStepWidget::updateRunButton);
+  }
   for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged}) {
     connect(m_document, signal, this, [this] {
       if (m_thread) m_inputsChangedDuringRun = true;
     });
   }
   syncControls();
+  updateRunButton();
 }
 
 RegisterStepWidget::~RegisterStepWidget() {
@@ -147,9 +153,76 @@ QString RegisterStepWidget::message() const { return m_message->text(); }
 
 QString RegisterStepWidget::logText() const { return m_log->toPlainText(); }
 
+QString RegisterStepWidget::progressText() const { return m_progressLabel->text(); }
+
+QString RegisterStepWidget::missingInputs() const {
+  QStringList missing;
+  if (!m_document->ct()) missing << tr("a CT (Data step)");
+  if (m_document->views().empty()) missing << tr("X-ray views (Data step)");
+  if (!m_document->initialPose()) missing << tr("an initial pose (Initial pose step: landmarks or the supine AP preset)");
+  return missing.join(QStringLiteral(", "));
+}
+
+void RegisterStepWidget::updateRunButton() {
+  const QString missing = missingInputs();
+  m_runButton->setEnabled(!m_thread && missing.isEmpty());
+  m_runButton->setToolTip(missing.isEmpty() ? tr("Register the CT to the X-rays from the initial pose")
+                                            : tr("Run needs %1").arg(missing));
+}
+
+QString RegisterStepWidget::plainStageName(const std::string& stage) {
+  const QString name = QString::fromStdString(stage);
+  const qsizetype colon = name.lastIndexOf(QLatin1Char('-'));
+  const QString level = colon >= 0 ? name.mid(colon + 1) : QString();
+  QString plain;
+  if (name.contains(QStringLiteral("whole"))) {
+    plain = tr("Coarse alignment (whole images)");
+  } else if (level == QStringLiteral("1:1")) {
+    plain = tr("Final (full resolution)");
+  } else {
+    plain = level.isEmpty() ? tr("Refinement (bone edges)") : tr("Refinement (bone edges, %1)").arg(level);
+  }
+  return QStringLiteral("%1 [%2]").arg(plain, name);
+}
+
+void RegisterStepWidget::logStages(const RegistrationResult& result) {
+  for (const StageReport& stage : result.stages) {
+    appendLog(QString::fromStdString(fmt::format(
+                  "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}",
+                  plainStageName(stage.name).toStdString(), RegistrationSchedule::metricName(stage.metric), stage.level,
+                  RegistrationSchedule::searchName(stage.search), stage.evaluations, stage.drrs, stage.startSimilarity,
+                  stage.similarity, stage.seconds, stage.cancelled ? " (cancelled)" : "")));
+  }
+}
+
+void RegisterStepWidget::showDocumentResult() {
+  const RegistrationResult* result = m_document->result();
+  if (m_thread || (m_ranHere && result)) return;
+  m_ranHere = false;
+  m_log->clear();
+  if (!result) {
+    m_progressBar->setValue(0);
+    m_progressLabel->setText(tr("Not started"));
+    return;
+  }
+  const QString summary = tr("Result %1 of %2 of this session: preset %3, %4 DRRs in %5 s%6.")
+                              .arg(m_document->currentResultIndex() + 1)
+                              .arg(m_document->results().size())
+                              .arg(QString::fromStdString(result->schedule.name))
+                              .arg(result->totalDrrs)
+                              .arg(result->totalSeconds, 0, 'f', 1)
+                              .arg(result->cancelled ? tr(", cancelled") : QString());
+  m_progressBar->setValue(result->cancelled ? 0 : m_progressBar->maximum());
+  m_progressLabel->setText(result->cancelled ? tr("Cancelled") : tr("Finished"));
+  appendLog(summary);
+  logStages(*result);
+  showMessage(summary + tr(" Judge it in the Review step, or run again."), false);
+}
+
 void RegisterStepWidget::showMessage(const QString& text, bool error) {
   m_message->setStyleSheet(error ? QStringLiteral("color: #c0392b;") : QString());
   m_message->setText(text);
+  emit statusMessage(text);
 }
 
 void RegisterStepWidget::appendLog(const QString& line) { m_log->appendPlainText(line); }
@@ -180,8 +253,8 @@ bool RegisterStepWidget::run() {
     return false;
   }
   const auto& initial = m_document->initialPose();
-  if (!initial) {
-    showMessage(tr("No initial pose: set one in the Initial pose step (landmarks or the supine AP preset)."), true);
+  if (const QString missing = missingInputs(); !missing.isEmpty()) {
+    showMessage(tr("Not ready to run: it needs %1.").arg(missing), true);
     return false;
   }
   const StudioRegistrationOptions& studioOptions = m_document->registrationOptions();
@@ -218,6 +291,8 @@ bool RegisterStepWidget::run() {
 
   m_lastProgress = RegistrationProgress{};
   m_inputsChangedDuringRun = false;
+  m_ranHere = true;
+  m_runTimer.start();
   m_worker = new RegistrationWorker(prepared.value(), *initial, std::move(options));
   m_thread = new QThread(this);
   m_worker->moveToThread(m_thread);
@@ -244,27 +319,28 @@ void RegisterStepWidget::onProgress(const RegistrationProgress& progress) {
     appendLog(tr("Stage %1/%2: %3")
                   .arg(progress.stageIndex + 1)
                   .arg(progress.stageCount)
-                  .arg(QString::fromStdString(progress.stage)));
+                  .arg(plainStageName(progress.stage)));
   }
   m_lastProgress = progress;
   m_progressBar->setValue(static_cast<int>(1000.0 * progress.fraction));
-  m_progressLabel->setText(tr("Stage %1/%2 %3 — %4 DRRs — best similarity %5")
+  // Time left from the time so far and the run's fraction done (shown once a twentieth is done).
+  const double elapsed_s = 1e-3 * static_cast<double>(m_runTimer.elapsed());
+  const QString left = progress.fraction >= 0.05 && progress.fraction < 1.0
+                           ? tr(" — about %1 s left").arg(elapsed_s * (1.0 - progress.fraction) / progress.fraction, 0,
+                                                           'f', 0)
+                           : QString();
+  m_progressLabel->setText(tr("Stage %1 of %2: %3 — %4 DRRs so far — image match %5 (higher is better)%6")
                                .arg(progress.stageIndex + 1)
                                .arg(progress.stageCount)
-                               .arg(QString::fromStdString(progress.stage))
+                               .arg(plainStageName(progress.stage))
                                .arg(progress.drrs)
-                               .arg(progress.bestSimilarity, 0, 'f', 4));
+                               .arg(progress.bestSimilarity, 0, 'f', 4)
+                               .arg(left));
 }
 
 void RegisterStepWidget::onFinished(const RegistrationResult& result) {
   endThread();
-  for (const StageReport& stage : result.stages) {
-    appendLog(QString::fromStdString(fmt::format(
-        "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}", stage.name,
-        RegistrationSchedule::metricName(stage.metric), stage.level, RegistrationSchedule::searchName(stage.search),
-        stage.evaluations, stage.drrs, stage.startSimilarity, stage.similarity, stage.seconds,
-        stage.cancelled ? " (cancelled)" : "")));
-  }
+  logStages(result);
   QString summary = tr("%1 DRRs in %2 s").arg(result.totalDrrs).arg(result.totalSeconds, 0, 'f', 1);
   if (result.cancelled) {
     summary = tr("Cancelled: the best pose so far is kept, marked cancelled (%1).").arg(summary);
@@ -278,9 +354,13 @@ void RegisterStepWidget::onFinished(const RegistrationResult& result) {
     appendLog(summary);
     showMessage(summary, true);
   } else {
+    if (!m_document->addResult(result)) {
+      summary += tr(" The accepted result stays current; this run is kept as result %1 of the history: compare it in "
+                    "the Review step.")
+                     .arg(m_document->results().size());
+    }
     appendLog(summary);
     showMessage(summary, false);
-    m_document->setResult(result);
   }
   setRunningUi(false);
   emit runningChanged(false);
@@ -305,13 +385,13 @@ void RegisterStepWidget::endThread() {
 }
 
 void RegisterStepWidget::setRunningUi(bool running) {
-  m_runButton->setEnabled(!running);
   m_cancelButton->setEnabled(running);
   for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
                                                           m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
                                                           m_cmaesCheck, m_noTransgraphCheck, m_noCtPyramidCheck}) {
     control->setEnabled(!running);
   }
+  updateRunButton();
 }
 
 }  // namespace fct

@@ -3,9 +3,11 @@
 // RegistrationWorker on its own thread from the document's initial pose, with the document's ROI window and
 // fraction in every ROI stage; a progress bar (stage, DRRs, best similarity) and a log follow it through queued
 // signals while the window stays responsive. Cancel stops the run at the next DRR set; the best pose so far is kept
-// and marked cancelled. The result (finished or cancelled) goes into the document, unless the CT or the views changed
-// during the run (then it is reported and dropped).
+// and marked cancelled. The result (finished or cancelled) joins the document's result history, unless the CT or the
+// views changed during the run (then it is reported and dropped); it becomes the current result unless the current one
+// is accepted, which only the user replaces (Review step).
 
+#include <QElapsedTimer>
 #include <QString>
 #include <QWidget>
 
@@ -56,6 +58,16 @@ class RegisterStepWidget : public QWidget {
   QString message() const;
   /// The log text.
   QString logText() const;
+  /// What Run still needs, in words ("a CT (Data step), an initial pose (Initial pose step)"); empty when ready.
+  QString missingInputs() const;
+  /// The Run button (disabled while inputs are missing, its tooltip naming them).
+  QPushButton* runButton() const { return m_runButton; }
+  /// The progress line under the bar, as shown.
+  QString progressText() const;
+  /// A preset stage's name in words for the progress line and log: "whole" stages are the coarse alignment on whole
+  /// images, a 1:1 ROI stage the final one at full resolution, other ROI stages the refinement on bone edges; the
+  /// preset's own name is kept in brackets ("Refinement (bone edges, 1:4) [vlnc-rois-1:4]").
+  static QString plainStageName(const std::string& stage);
 
  public slots:
   /// Starts a registration; false (with the reason shown) when one runs already or the CT, views, initial pose,
@@ -67,6 +79,8 @@ class RegisterStepWidget : public QWidget {
  signals:
   /// A run started (true) or ended (false).
   void runningChanged(bool running);
+  /// The step's message changed (for the status line).
+  void statusMessage(const QString& message);
 
  private:
   void onProgress(const RegistrationProgress& progress);
@@ -76,11 +90,18 @@ class RegisterStepWidget : public QWidget {
   void endThread();
   /// Enables the controls for the running state.
   void setRunningUi(bool running);
+  /// Enables Run when nothing runs and no input is missing; its tooltip says what is missing.
+  void updateRunButton();
   /// Copies the document's options into the controls.
   void syncControls();
   /// Writes the controls' options into the document.
   void pushOptions();
   void appendLog(const QString& line);
+  /// Appends one line per stage of `result` to the log.
+  void logStages(const RegistrationResult& result);
+  /// When no run of this step is shown (e.g. after a session was opened), shows the document's current result: its
+  /// summary, a full bar and its stages in the log.
+  void showDocumentResult();
   void showMessage(const QString& text, bool error);
 
   StudioDocument* m_document;
@@ -88,6 +109,8 @@ class RegisterStepWidget : public QWidget {
   RegistrationWorker* m_worker = nullptr;
   RegistrationProgress m_lastProgress;
   bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
+  bool m_ranHere = false;                 ///< a run of this widget is shown (not a result from the session)
+  QElapsedTimer m_runTimer;               ///< since the current run started (for the time left)
 
   QComboBox* m_presetCombo;
   QSpinBox* m_seedSpin;

@@ -69,6 +69,16 @@ QImage greyDrr(const FloatImage& drr) {
   return grey;
 }
 
+/// The verdict of a result in words.
+QString verdictName(ResultVerdict verdict) {
+  switch (verdict) {
+    case ResultVerdict::Accepted: return QObject::tr("accepted");
+    case ResultVerdict::Rejected: return QObject::tr("rejected");
+    case ResultVerdict::Undecided: break;
+  }
+  return QObject::tr("not judged");
+}
+
 }  // namespace
 
 ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
@@ -77,6 +87,13 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
       m_initialColour(colourOf(ContourOverlay::kInitialColour)),
       m_finalColour(colourOf(ContourOverlay::kFinalColour)) {
   auto* layout = new QVBoxLayout(this);
+
+  auto* historyRow = new QHBoxLayout();
+  m_historyCombo = new QComboBox(this);
+  m_historyCombo->setToolTip(tr("Every registration of this session; choose one to review, accept or export it"));
+  historyRow->addWidget(new QLabel(tr("Result"), this));
+  historyRow->addWidget(m_historyCombo, 1);
+  layout->addLayout(historyRow);
 
   auto* contourBox = new QGroupBox(tr("Bone outlines"), this);
   auto* contourForm = new QFormLayout(contourBox);
@@ -182,10 +199,11 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
           [this](int index) { setDrrMode(static_cast<DrrMode>(index)); });
   connect(m_drrOpacitySlider, &QSlider::valueChanged, this, [this](int value) { setDrrOpacity(value / 100.0); });
   connect(m_flickerCheck, &QCheckBox::toggled, this, &ReviewStepWidget::setFlicker);
+  connect(m_historyCombo, &QComboBox::activated, m_document, &StudioDocument::setCurrentResult);
   connect(acceptButton, &QPushButton::clicked, this, &ReviewStepWidget::acceptResult);
   connect(rejectButton, &QPushButton::clicked, this, &ReviewStepWidget::rejectResult);
   connect(exportButton, &QPushButton::clicked, this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Export pose"), QStringLiteral("pose.tfm"),
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export pose"), m_document->suggestedPath(QStringLiteral("pose.tfm")),
                                                       tr("3D Slicer transform (*.tfm);;Pose JSON (*.json)"));
     if (!path.isEmpty()) exportPose(path);
   });
@@ -207,7 +225,7 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
     if (!path.isEmpty()) exportDicomRegistration(path);
   });
   connect(screenshotButton, &QPushButton::clicked, this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save screenshot"), QStringLiteral("review.png"),
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save screenshot"), m_document->suggestedPath(QStringLiteral("review.png")),
                                                       tr("PNG image (*.png)"));
     if (!path.isEmpty()) saveScreenshot(path);
   });
@@ -470,6 +488,22 @@ void ReviewStepWidget::rejectResult() {
 }
 
 void ReviewStepWidget::updateVerdict() {
+  {
+    const QSignalBlocker blocker(m_historyCombo);
+    m_historyCombo->clear();
+    const auto& results = m_document->results();
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      const RegistrationResult& r = results[i].result;
+      m_historyCombo->addItem(tr("%1. %2, %3 s%4 — %5")
+                                  .arg(i + 1)
+                                  .arg(QString::fromStdString(r.schedule.name))
+                                  .arg(r.totalSeconds, 0, 'f', 1)
+                                  .arg(r.cancelled ? tr(", cancelled") : QString())
+                                  .arg(verdictName(results[i].verdict)));
+    }
+    m_historyCombo->setCurrentIndex(m_document->currentResultIndex());
+    m_historyCombo->setEnabled(results.size() > 1);
+  }
   const auto& result = m_document->result();
   if (!result) {
     m_verdictLabel->setText(tr("No result"));

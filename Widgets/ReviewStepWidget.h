@@ -3,10 +3,11 @@
 // X-ray: the projected bone outlines (ContourOverlay) at the initial and at the final pose, each toggled, coloured and
 // with an opacity; the DRR at the final pose blended over the X-ray or as a checkerboard, with a flicker toggle
 // (a QTimer switching the DRR on and off). With a ground truth (simulated case) the sTRE, the mean bone-surface
-// distance to the truth (BoneSurface), is shown for both poses. Accept / Reject record the verdict in the document;
-// the final pose exports as an ITK .tfm for 3D Slicer, as pose JSON or as a DICOM registration (REG), and the X-ray
-// views as a PNG screenshot; "Send to Slicer" sends it live to 3D Slicer's OpenIGTLinkIF (host and port fields) off
-// the GUI thread.
+// distance to the truth (BoneSurface), is shown for both poses. A chooser lists the session's result history (each run
+// with its preset, time and verdict) and makes one the current result. Accept / Reject record the verdict in the
+// document; the final pose exports as an ITK .tfm for 3D Slicer, as pose JSON or as a DICOM registration (REG), and the
+// X-ray views as a PNG screenshot; "Send to Slicer" sends it live to 3D Slicer's OpenIGTLinkIF (host and port fields)
+// off the GUI thread.
 
 #include <Eigen/Core>
 #include <QColor>
@@ -68,6 +69,8 @@ class ReviewStepWidget : public QWidget {
   QString message() const;
   /// True while the DRR flickers.
   bool isFlickering() const;
+  /// The result history chooser (one entry per result, the current one selected).
+  QComboBox* historyChooser() const { return m_historyCombo; }
 
  public slots:
   /// Recomputes the contours, the DRR and the sTRE for the current document and redraws.
@@ -114,6 +117,7 @@ class ReviewStepWidget : public QWidget {
   void drawContours();
   /// Redraws the DRR layer from the cached DRRs.
   void drawDrr();
+  /// Shows the current result's verdict and refills the history chooser.
   void updateVerdict();
   void showMessage(const QString& text, bool error);
 
@@ -139,6 +143,7 @@ class ReviewStepWidget : public QWidget {
   double m_drrOpacity = 0.5;
   bool m_flickerShown = true;
 
+  QComboBox* m_historyCombo;
   QCheckBox* m_initialCheck;
   QCheckBox* m_finalCheck;
   QPushButton* m_initialColourButton;

@@ -17,6 +17,7 @@
 #include <QVBoxLayout>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -27,7 +28,10 @@ namespace fct {
 namespace {
 
 const QColor kRoiColour(255, 200, 0);
-const QColor kExcludedColour(40, 90, 255);
+const QColor kExcludedColour(40, 90, 255);        ///< outside the field of view
+const QColor kMarginColour(150, 150, 190);        ///< the image margin
+const QColor kSphereExcludedColour(200, 60, 200);  ///< a calibration sphere's shadow
+const QColor kOtherExcludedColour(255, 150, 0);   ///< metal, or the inside of a non-circular collimator edge
 const QColor kSphereColour(255, 60, 200);
 constexpr double kRoiOpacity = 0.5;
 constexpr double kExcludedOpacity = 0.35;
@@ -92,7 +96,7 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
   form->addRow(m_fractionRadio, sliderRow(m_fractionSlider, m_fractionSpin, roiBox));
   layout->addWidget(roiBox);
 
-  auto* exclusionBox = new QGroupBox(tr("Excluded pixels (blue)"), this);
+  auto* exclusionBox = new QGroupBox(tr("Excluded pixels (coloured by reason, see below)"), this);
   auto* exclusionForm = new QFormLayout(exclusionBox);
   m_marginSpin = new QSpinBox(exclusionBox);
   m_marginSpin->setRange(0, 200);
@@ -101,13 +105,18 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
   exclusionForm->addRow(tr("Image margin"), m_marginSpin);
   m_fieldOfViewCheck = new QCheckBox(tr("Exclude outside the collimator / field of view"), exclusionBox);
   exclusionForm->addRow(m_fieldOfViewCheck);
-  m_spheresCheck = new QCheckBox(tr("Detect calibration spheres (view-file spheres always excluded)"), exclusionBox);
+  m_spheresCheck = new QCheckBox(tr("Detect more calibration spheres"), exclusionBox);
+  m_spheresCheck->setToolTip(tr("The spheres listed in the view file are always excluded; this also finds others"));
   exclusionForm->addRow(m_spheresCheck);
   layout->addWidget(exclusionBox);
 
   m_fractions = new QLabel(this);
   m_fractions->setTextInteractionFlags(Qt::TextSelectableByMouse);
   layout->addWidget(m_fractions);
+  m_exclusions = new QLabel(this);
+  m_exclusions->setWordWrap(true);
+  m_exclusions->setTextFormat(Qt::RichText);
+  layout->addWidget(m_exclusions);
   m_message = new QLabel(this);
   m_message->setWordWrap(true);
   layout->addWidget(m_message);
@@ -284,21 +293,54 @@ bool RoiStepWidget::ensureSelectors() {
   return true;
 }
 
+QString RoiStepWidget::exclusionText() const { return m_exclusions->text(); }
+
 void RoiStepWidget::drawExclusions() {
+  const RoiParameters& roi = m_document->roiParameters();
+  QStringList lines;
   for (std::size_t v = 0; v < m_xrayViews.size() && v < m_case->viewCount(); ++v) {
     const PreparedXray& prepared = m_case->prepared(v);
     const ValidMask& mask = prepared.pyramid.level(0).mask;
     QImage excluded(mask.cols, mask.rows, QImage::Format_ARGB32);
-    const QRgb on = kExcludedColour.rgba();
+    // Each excluded pixel is coloured by the first reason that explains it: margin, sphere, outside the circular
+    // field, else metal or a collimator edge (the masks are merged by XrayPreparation).
+    std::array<long, 4> counts{};  // margin, field, sphere, other
+    const int m = roi.margin_px;
     for (int row = 0; row < mask.rows; ++row) {
       auto* line = reinterpret_cast<QRgb*>(excluded.scanLine(row));
-      for (int col = 0; col < mask.cols; ++col) line[col] = mask.isValid(col, row) ? 0u : on;
+      for (int col = 0; col < mask.cols; ++col) {
+        if (mask.isValid(col, row)) {
+          line[col] = 0u;
+          continue;
+        }
+        const bool margin = col < m || row < m || col >= mask.cols - m || row >= mask.rows - m;
+        const bool sphere = std::any_of(prepared.spheres.begin(), prepared.spheres.end(), [&](const PixelCircle& s) {
+          PixelCircle grown = s;
+          grown.radius_px += roi.sphereMargin_px;
+          return grown.contains(col, row);
+        });
+        const bool field = prepared.fieldOfView && !prepared.fieldOfView->contains(col, row);
+        const int reason = margin ? 0 : sphere ? 2 : field ? 1 : 3;
+        ++counts[static_cast<std::size_t>(reason)];
+        static const QRgb kColours[4] = {kMarginColour.rgba(), kExcludedColour.rgba(), kSphereExcludedColour.rgba(),
+                                         kOtherExcludedColour.rgba()};
+        line[col] = kColours[reason];
+      }
     }
+    const double total = std::max(1.0, static_cast<double>(mask.cols) * mask.rows);
+    const auto share = [&](std::size_t i) { return QString::number(100.0 * counts[i] / total, 'f', 1); };
+    lines << tr("%1 excluded: <span style='color:%2'>margin %3 %</span>, <span style='color:%4'>outside the field %5 "
+                "%</span>, <span style='color:%6'>spheres %7 %</span>, <span style='color:%8'>%9 %10 %</span>")
+                 .arg(QString::fromStdString(m_case->viewName(v)).toHtmlEscaped(), kMarginColour.name(), share(0),
+                      kExcludedColour.name(), share(1), kSphereExcludedColour.name(), share(2),
+                      kOtherExcludedColour.name(),
+                      prepared.metalFraction > 0.0 ? tr("metal or collimator edge") : tr("collimator edge"), share(3));
     m_xrayViews[v]->setImageLayer(kExcludedLayer, std::move(excluded), kExcludedOpacity);
     std::vector<std::vector<Eigen::Vector2d>> spheres;
     for (const PixelCircle& sphere : prepared.spheres) spheres.push_back(circlePolyline(sphere));
     m_xrayViews[v]->setPolylineLayer(kSphereLayer, std::move(spheres), kSphereColour);
   }
+  m_exclusions->setText(lines.join(QStringLiteral("<br>")));
   m_exclusionsDrawn = true;
 }
 

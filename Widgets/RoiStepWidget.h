@@ -61,6 +61,9 @@ class RoiStepWidget : public QWidget {
 
   /// Kept fraction (kept pixels / valid pixels) of view v at the current settings; NaN when unknown.
   double keptFraction(std::size_t v) const;
+  /// Per view, why pixels are excluded and how many (margin, field of view, spheres, other: metal or collimator), as
+  /// shown under the fractions.
+  QString exclusionText() const;
   /// Pyramid level the ROIs are shown for (0 = full resolution).
   int level() const { return m_level; }
   /// The message line, as shown.
@@ -112,6 +115,7 @@ class RoiStepWidget : public QWidget {
   QCheckBox* m_fieldOfViewCheck;
   QCheckBox* m_spheresCheck;
   QLabel* m_fractions;
+  QLabel* m_exclusions;  ///< per view, the share of the image each exclusion takes
   QLabel* m_message;
 };
 

@@ -202,6 +202,7 @@ bool Scene3DWidget::openGlAvailable() {
 }
 
 Scene3DWidget::~Scene3DWidget() {
+  if (context()) disconnect(context(), nullptr, this, nullptr);  // the context outlives this part of the object
   makeCurrent();
   m_window->Finalize();
   doneCurrent();
@@ -351,8 +352,17 @@ void Scene3DWidget::resetCamera() {
 }
 
 void Scene3DWidget::initializeGL() {
+  // Qt makes a new context when the view moves to another window: VTK's objects of the old one go with it, and the
+  // new one is set up as the first was (otherwise the view stays black).
+  connect(context(), &QOpenGLContext::aboutToBeDestroyed, this, &Scene3DWidget::releaseGraphics, Qt::UniqueConnection);
   m_window->SetOwnContext(false);
   m_window->OpenGLInitContext();  // this widget's context is current and new
+}
+
+void Scene3DWidget::releaseGraphics() {
+  makeCurrent();
+  m_window->ReleaseGraphicsResources(m_window);
+  doneCurrent();
 }
 
 void Scene3DWidget::paintGL() {
@@ -361,6 +371,7 @@ void Scene3DWidget::paintGL() {
   const qreal ratio = devicePixelRatioF();
   const int w = static_cast<int>(width() * ratio);
   const int h = static_cast<int>(height() * ratio);
+  if (w <= 0 || h <= 0) return;  // collapsed: nothing to draw, and VTK's framebuffers keep their last size
   m_window->SetSize(w, h);
   m_interactor->SetSize(w, h);
   // VTK renders into its own framebuffers; then the image is copied into this widget's framebuffer.

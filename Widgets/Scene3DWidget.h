@@ -71,6 +71,8 @@ class Scene3DWidget : public QOpenGLWidget {
   void updatePose();
   /// Forwards a mouse event to VTK's interactor and repaints.
   void forwardMouse(QMouseEvent* event, unsigned long vtkEvent);
+  /// Frees VTK's OpenGL objects of the widget's context before Qt destroys it.
+  void releaseGraphics();
 
   StudioDocument* m_document;
   double m_boneThreshold_hu = 250.0;

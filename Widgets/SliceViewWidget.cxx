@@ -68,6 +68,12 @@ SliceViewWidget::SliceViewWidget(SliceOrientation orientation, QWidget* parent)
   connect(this, &ImageViewWidget::pixelHovered, this, [this](const Eigen::Vector2d& uv_px, float value) {
     if (m_ct) emit ctPointHovered(ctPointForPixel(uv_px), value);
   });
+  connect(this, &ImageViewWidget::markerClicked, this, [this](const QString& layer, int index) {
+    for (const CtLayer& l : m_ctLayers) {
+      if (QStringLiteral("ct:") + l.name != layer || index < 0 || index >= static_cast<int>(l.shownIndex.size())) continue;
+      emit ctPointClicked(l.name, l.shownIndex[static_cast<std::size_t>(index)]);
+    }
+  });
   connect(this, &ImageViewWidget::pointDragged, this, [this](const QString& layer, int index, const Eigen::Vector2d& uv_px) {
     for (const CtLayer& l : m_ctLayers) {
       if (QStringLiteral("ct:") + l.name != layer || index < 0 || index >= static_cast<int>(l.shownIndex.size())) continue;
@@ -86,6 +92,21 @@ QString SliceViewWidget::orientationName(SliceOrientation orientation) {
       return tr("Sagittal");
   }
   return {};
+}
+
+QString SliceViewWidget::sideCoordinate(int lpsAxis, double value_mm) {
+  static const char* const kSides[3][2] = {{"R", "L"}, {"A", "P"}, {"I", "S"}};  // {negative, positive} side
+  const int axis = std::clamp(lpsAxis, 0, 2);
+  const double rounded = std::round(value_mm * 10.0) / 10.0;  // "L 0.0", never "R -0.0"
+  return QStringLiteral("%1 %2").arg(QLatin1String(kSides[axis][rounded >= 0.0 ? 1 : 0])).arg(std::abs(rounded), 0, 'f', 1);
+}
+
+QString SliceViewWidget::positionText(const Eigen::Vector3d& p_ct_mm) {
+  return tr("LPS (%1, %2, %3) mm = %4 %5 %6")
+      .arg(p_ct_mm.x(), 0, 'f', 1)
+      .arg(p_ct_mm.y(), 0, 'f', 1)
+      .arg(p_ct_mm.z(), 0, 'f', 1)
+      .arg(sideCoordinate(0, p_ct_mm.x()), sideCoordinate(1, p_ct_mm.y()), sideCoordinate(2, p_ct_mm.z()));
 }
 
 void SliceViewWidget::setVolume(std::shared_ptr<const Volume> ct) {
@@ -208,12 +229,11 @@ void SliceViewWidget::updateSlice() {
   }
   const bool firstImage = !hasImage();
   setImage(slice, /*keepView=*/!firstImage);
-  setTitle(QStringLiteral("%1  %2 %3 mm")
-               .arg(orientationName(m_orientation))
-               .arg(m_orientation == SliceOrientation::Axial     ? QStringLiteral("S")
-                    : m_orientation == SliceOrientation::Coronal ? QStringLiteral("P")
-                                                                 : QStringLiteral("R"))
-               .arg(slicePosition_mm(), 0, 'f', 1));
+  const int axis = m_orientation == SliceOrientation::Axial ? 2 : m_orientation == SliceOrientation::Coronal ? 1 : 0;
+  setTitle(tr("%1  %2 mm (LPS %3 %4)")
+               .arg(orientationName(m_orientation), sideCoordinate(axis, m_crosshair_ct_mm[axis]))
+               .arg(QLatin1Char("xyz"[axis]))
+               .arg(m_crosshair_ct_mm[axis], 0, 'f', 1));
   updateOverlays();
 }
 

@@ -2,8 +2,9 @@
 // SliceViewWidget: one CT slice, axial, coronal or sagittal in the CT's LPS frame, resampled on square pixels
 // (trilinear), shown as an ImageViewWidget with a crosshair and CT point layers. Radiological layout as in 3D Slicer:
 // axial: patient's left to the screen's right, posterior down; coronal: left to the right, inferior down;
-// sagittal: posterior to the right, inferior down. Mouse: wheel scrolls slices, ctrl + wheel zooms, middle or right
-// drag pans, ctrl + left drag changes window/level, left click emits pointClicked with the CT point (LPS mm).
+// sagittal: posterior to the right, inferior down. The title gives the slice's position as its patient side and its
+// LPS coordinate ("Sagittal  L 38.8 mm (LPS x 38.8)"). Mouse: wheel scrolls slices, ctrl + wheel zooms, middle or
+// right drag pans, ctrl + left drag changes window/level, left click emits pointClicked with the CT point (LPS mm).
 
 #include <Eigen/Core>
 #include <QColor>
@@ -45,6 +46,11 @@ class SliceViewWidget : public ImageViewWidget {
   SliceOrientation orientation() const { return m_orientation; }
   /// Display name of an orientation ("Axial", "Coronal", "Sagittal").
   static QString orientationName(SliceOrientation orientation);
+  /// A coordinate along LPS axis `lpsAxis` (0 x, 1 y, 2 z; mm) as the patient side it lies on, without a sign:
+  /// "L 38.8" for x = 38.8 and "R 38.8" for x = -38.8 (likewise P/A for y, S/I for z).
+  static QString sideCoordinate(int lpsAxis, double value_mm);
+  /// A CT point in both forms every position of the Studio uses: "LPS (38.8, -12.0, 5.0) mm = L 38.8 A 12.0 S 5.0".
+  static QString positionText(const Eigen::Vector3d& p_ct_mm);
 
   /// Moves the crosshair to a CT point (LPS mm); the slice follows it along the view's normal. Does not emit.
   void setCrosshair_ct_mm(const Eigen::Vector3d& p_ct_mm);
@@ -75,6 +81,8 @@ class SliceViewWidget : public ImageViewWidget {
   void pointClicked(const Eigen::Vector3d& p_ct_mm);
   /// The user scrolled the slice; the crosshair is now at p_ct_mm (for linking the other views).
   void crosshairMoved(const Eigen::Vector3d& p_ct_mm);
+  /// A draggable CT point was clicked without moving it (index into the layer's points).
+  void ctPointClicked(const QString& layer, int index);
   /// A draggable CT point was moved to p_ct_mm (in the slice plane).
   void ctPointDragged(const QString& layer, int index, const Eigen::Vector3d& p_ct_mm);
   /// The CT point and value (HU) under the cursor.

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <set>
 #include <utility>
 
@@ -58,6 +59,11 @@ void StudioDocument::setCt(std::shared_ptr<const Volume> ct, fs::path path, std:
   m_ctSeriesUid = std::move(seriesUid);
   invalidateCase();
   emit ctChanged();
+  if (!m_landmarks.ct.empty() || !m_landmarks.imageByView.empty()) {
+    m_landmarks = {};
+    emit landmarksChanged();
+  }
+  dropPoseAndResults();
   touch();
 }
 
@@ -138,11 +144,69 @@ Status StudioDocument::addXrayViews(std::vector<RegistrationView> added, const s
 }
 
 void StudioDocument::setViews(std::vector<RegistrationView> views, fs::path viewFile, std::vector<std::string> warnings) {
+  // The old views' X-ray landmarks and windows survive only when the old views are kept as they were (views added).
+  const auto sameView = [](const RegistrationView& a, const RegistrationView& b) {
+    return a.name == b.name && a.xray.sourcePath == b.xray.sourcePath;
+  };
+  const bool appended = viewFile == m_viewFilePath && views.size() >= m_views.size() &&
+                        std::equal(m_views.begin(), m_views.end(), views.begin(), sameView);
   m_views = std::move(views);
   m_viewFilePath = std::move(viewFile);
   m_viewWarnings = std::move(warnings);
   invalidateCase();
   emit viewsChanged();
+  if (!appended) {
+    m_xrayWindows.clear();
+    if (!m_landmarks.imageByView.empty()) {
+      m_landmarks.imageByView.clear();
+      emit landmarksChanged();
+    }
+  }
+  dropPoseAndResults();
+  touch();
+}
+
+void StudioDocument::dropPoseAndResults() {
+  if (m_initialPose) {
+    m_initialPose.reset();
+    m_initialPoseSource.clear();
+    emit initialPoseChanged();
+  }
+  if (!m_results.empty()) {
+    m_results.clear();
+    m_currentResult = -1;
+    emit resultChanged();
+  }
+  if (m_truthPose) {
+    m_truthPose.reset();
+    emit truthPoseChanged();
+  }
+}
+
+QString StudioDocument::suggestedPath(const QString& fileName) const {
+  fs::path folder;
+  if (!m_sessionPath.empty()) {
+    folder = m_sessionPath.parent_path();
+  } else if (!m_viewFilePath.empty()) {
+    folder = m_viewFilePath.parent_path();
+  } else if (!m_views.empty() && !m_views.front().xray.sourcePath.empty()) {
+    folder = fs::path(m_views.front().xray.sourcePath).parent_path();
+  } else if (!m_ctPath.empty()) {
+    folder = m_ctPath.parent_path();  // a DICOM folder's parent, too
+  }
+  if (folder.empty()) return fileName;
+  return QString::fromStdString((folder / fileName.toStdString()).string());
+}
+
+bool StudioDocument::hasDerivedState() const {
+  return !m_landmarks.ct.empty() || !m_landmarks.imageByView.empty() || m_initialPose || !m_results.empty();
+}
+
+void StudioDocument::setXrayWindow(const std::string& viewName, const DisplayWindow& window) {
+  const auto found = m_xrayWindows.find(viewName);
+  if (found != m_xrayWindows.end() && found->second == window) return;
+  m_xrayWindows[viewName] = window;
+  emit xrayWindowsChanged();
   touch();
 }
 
@@ -212,16 +276,40 @@ Result<std::shared_ptr<RegistrationCase>> StudioDocument::preparedCase() {
   return prepared;
 }
 
-void StudioDocument::setResult(std::optional<RegistrationResult> result) {
-  m_result = std::move(result);
-  m_verdict = ResultVerdict::Undecided;
+const RegistrationResult* StudioDocument::result() const {
+  return m_currentResult >= 0 ? &m_results[static_cast<std::size_t>(m_currentResult)].result : nullptr;
+}
+
+ResultVerdict StudioDocument::resultVerdict() const {
+  return m_currentResult >= 0 ? m_results[static_cast<std::size_t>(m_currentResult)].verdict : ResultVerdict::Undecided;
+}
+
+bool StudioDocument::addResult(RegistrationResult result) {
+  m_results.push_back(StudioResult{std::move(result), ResultVerdict::Undecided});
+  const bool becomesCurrent = resultVerdict() != ResultVerdict::Accepted;
+  if (becomesCurrent) m_currentResult = static_cast<int>(m_results.size()) - 1;
+  emit resultChanged();
+  touch();
+  return becomesCurrent;
+}
+
+void StudioDocument::setCurrentResult(int index) {
+  if (index < 0 || index >= static_cast<int>(m_results.size()) || index == m_currentResult) return;
+  m_currentResult = index;
+  emit resultChanged();
+  touch();
+}
+
+void StudioDocument::setResults(std::vector<StudioResult> results, int current) {
+  m_results = std::move(results);
+  m_currentResult = m_results.empty() ? -1 : std::clamp(current, 0, static_cast<int>(m_results.size()) - 1);
   emit resultChanged();
   touch();
 }
 
 void StudioDocument::setResultVerdict(ResultVerdict verdict) {
-  if (verdict == m_verdict) return;
-  m_verdict = verdict;
+  if (m_currentResult < 0 || verdict == resultVerdict()) return;
+  m_results[static_cast<std::size_t>(m_currentResult)].verdict = verdict;
   emit resultChanged();
   touch();
 }
@@ -245,8 +333,9 @@ void StudioDocument::clear() {
   m_initialPoseSource.clear();
   m_roi = {};
   m_options = {};
-  m_result.reset();
-  m_verdict = ResultVerdict::Undecided;
+  m_results.clear();
+  m_currentResult = -1;
+  m_xrayWindows.clear();
   m_truthPose.reset();
   m_sessionPath.clear();
   invalidateCase();

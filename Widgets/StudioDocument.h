@@ -1,9 +1,11 @@
 #pragma once
 // StudioDocument: the state of one FluoroCT Studio session, shared by every step widget and view: the CT, the C-arm
-// views with their X-rays, the landmarks, the initial pose, the ROI parameters, the registration options and the last
-// result. Setters emit one specific signal per part and `changed()`; any change marks the document modified.
-// Loading goes through CtLoader, RegistrationViewLoader and XrayLoader and never throws: failures come back as a
-// Status whose message says what to do, and leave the document as it was.
+// views with their X-rays, the landmarks, the initial pose, the ROI parameters, the registration options, the history
+// of registration results with the user's verdicts, and the X-ray display windows. Setters emit one specific signal
+// per part and `changed()`; any change marks the document modified. Replacing the CT or the views drops everything
+// derived from them (landmarks of the replaced input, initial pose, results, ground truth), so no result outlives the
+// images it was made from. Loading goes through CtLoader, RegistrationViewLoader and XrayLoader and never throws:
+// failures come back as a Status whose message says what to do, and leave the document as it was.
 
 #include <Eigen/Geometry>
 #include <QObject>
@@ -11,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,6 +54,20 @@ struct StudioRegistrationOptions {
 /// The user's verdict on a registration result.
 enum class ResultVerdict { Undecided, Accepted, Rejected };
 
+/// One entry of the session's result history: a registration result and the user's verdict on it.
+struct StudioResult {
+  RegistrationResult result;
+  ResultVerdict verdict = ResultVerdict::Undecided;
+};
+
+/// A display window of an image view: width and centre, in the image's units.
+struct DisplayWindow {
+  double window = 1.0;
+  double level = 0.5;
+
+  bool operator==(const DisplayWindow&) const = default;
+};
+
 /// A CT read from disk, ready to be put into a document (see StudioDocument::readCt).
 struct LoadedCt {
   std::shared_ptr<const Volume> ct;
@@ -88,9 +105,10 @@ class StudioDocument : public QObject {
   static Result<LoadedCt> readCt(const std::filesystem::path& path, const DicomSeriesReadOptions& options = {});
   /// readCt() then setCt(). On failure the document is unchanged and the Status says why.
   Status loadCt(const std::filesystem::path& path, const DicomSeriesReadOptions& options = {});
-  /// Puts a CT read by readCt() into the document; emits ctChanged().
+  /// Puts a CT read by readCt() into the document (see the next setCt); emits ctChanged().
   void setCt(LoadedCt loaded);
-  /// Replaces the CT (null clears it) with its source and warnings; emits ctChanged().
+  /// Replaces the CT (null clears it) with its source and warnings, dropping every landmark, the initial pose, the
+  /// results and the ground truth (they belong to the old CT); emits ctChanged() and the signals of what was dropped.
   void setCt(std::shared_ptr<const Volume> ct, std::filesystem::path path = {}, std::vector<std::string> warnings = {},
              std::string seriesUid = {});
 
@@ -106,8 +124,8 @@ class StudioDocument : public QObject {
   static Result<LoadedViews> readViews(const std::filesystem::path& viewFile);
   /// readViews() then setViews(). On failure the document is unchanged and the Status says why.
   Status loadViews(const std::filesystem::path& viewFile);
-  /// Puts views read by readViews() into the document with their ground truth; emits viewsChanged() and
-  /// truthPoseChanged().
+  /// Puts views read by readViews() into the document with their ground truth (see the next setViews); emits
+  /// viewsChanged() and truthPoseChanged().
   void setViews(LoadedViews loaded);
   /// Reads one X-ray DICOM file as a view named after the file, its camera from the C-arm geometry tags
   /// (DicomViewBuilder; a mirrored image is flipped), without touching any document. Fails when the file cannot be
@@ -120,7 +138,9 @@ class StudioDocument : public QObject {
   /// Adds views read by readXrayFile() (names made unique) and their warnings; refused while the views come from a
   /// view file. Emits viewsChanged() once.
   Status addXrayViews(std::vector<RegistrationView> views, const std::vector<std::string>& warnings = {});
-  /// Replaces the views and the view file path; emits viewsChanged().
+  /// Replaces the views and the view file path, dropping the X-ray landmarks of views no longer present (all of them
+  /// when the view file changes), the initial pose, the results, the ground truth and the X-ray windows of the old
+  /// views; emits viewsChanged() and the signals of what was dropped.
   void setViews(std::vector<RegistrationView> views, std::filesystem::path viewFile = {},
                 std::vector<std::string> warnings = {});
   /// Index of the view with this name, or -1.
@@ -155,19 +175,40 @@ class StudioDocument : public QObject {
   /// RegistrationCase::create.
   Result<std::shared_ptr<RegistrationCase>> preparedCase();
 
-  // --- Result and ground truth ------------------------------------------------------------------------------------
-  /// The last registration result, if any.
-  const std::optional<RegistrationResult>& result() const { return m_result; }
-  /// The user's verdict on it.
-  ResultVerdict resultVerdict() const { return m_verdict; }
-  /// Replaces the result (verdict reset to Undecided); emits resultChanged().
-  void setResult(std::optional<RegistrationResult> result);
-  /// Records accept or reject of the current result; emits resultChanged().
+  // --- Results and ground truth -----------------------------------------------------------------------------------
+  /// Every registration result of the session with its verdict, oldest first.
+  const std::vector<StudioResult>& results() const { return m_results; }
+  /// Index in results() of the result shown and judged (-1: none).
+  int currentResultIndex() const { return m_currentResult; }
+  /// The current result, or null when there is none.
+  const RegistrationResult* result() const;
+  /// The user's verdict on the current result (Undecided when there is none).
+  ResultVerdict resultVerdict() const;
+  /// Appends a result (verdict Undecided) to the history. It becomes the current result unless the current one is
+  /// accepted: an accepted result is only left by setCurrentResult(). Returns true if it became current. Emits
+  /// resultChanged().
+  bool addResult(RegistrationResult result);
+  /// Makes results()[index] the current result (out of range: ignored); emits resultChanged().
+  void setCurrentResult(int index);
+  /// Replaces the whole history and the current index (clamped; -1 for none), as read from a session file; emits
+  /// resultChanged().
+  void setResults(std::vector<StudioResult> results, int current);
+  /// Records accept or reject of the current result (no current result: ignored); emits resultChanged().
   void setResultVerdict(ResultVerdict verdict);
   /// The known true pose of a simulated case (T_world_from_ct), if any.
   const std::optional<Eigen::Isometry3d>& truthPose() const { return m_truthPose; }
   /// Sets or clears the ground truth; emits truthPoseChanged().
   void setTruthPose(std::optional<Eigen::Isometry3d> T_world_from_ct);
+
+  // --- Display ---------------------------------------------------------------------------------------------------
+  /// The window/level of each X-ray view the user set or that was read from the session, by view name.
+  const std::map<std::string, DisplayWindow>& xrayWindows() const { return m_xrayWindows; }
+  /// Records view `viewName`'s window/level (saved in the session); emits xrayWindowsChanged() when it differs.
+  void setXrayWindow(const std::string& viewName, const DisplayWindow& window);
+
+  /// True when the document holds work derived from its inputs (landmarks, an initial pose or results), which
+  /// replacing the CT or the views would drop.
+  bool hasDerivedState() const;
 
   // --- Session bookkeeping ------------------------------------------------------------------------------------------
   /// True when there are changes not saved to the session file.
@@ -176,6 +217,9 @@ class StudioDocument : public QObject {
   void setModified(bool modified);
   /// The session file this document was last saved to or opened from (empty if none).
   const std::filesystem::path& sessionPath() const { return m_sessionPath; }
+  /// `fileName` in the case folder, where save and export dialogs start: the session file's folder, else the view
+  /// file's, else the first X-ray's, else the CT's (a bare file name, in the working folder, when there is none).
+  QString suggestedPath(const QString& fileName) const;
   /// Sets the session file path (does not save).
   void setSessionPath(std::filesystem::path path) { m_sessionPath = std::move(path); }
   /// Empties the document (new session): every part cleared, not modified, no session path. Emits every signal.
@@ -194,10 +238,12 @@ class StudioDocument : public QObject {
   void roiParametersChanged();
   /// The registration options changed.
   void registrationOptionsChanged();
-  /// The result or its verdict changed.
+  /// The result history, the current result or its verdict changed.
   void resultChanged();
   /// The ground truth was set or cleared.
   void truthPoseChanged();
+  /// An X-ray view's recorded window/level changed.
+  void xrayWindowsChanged();
   /// Emitted after any change of the content (for autosave and the title bar).
   void changed();
   /// The document became modified (true) or saved (false).
@@ -208,6 +254,8 @@ class StudioDocument : public QObject {
   void touch();
   /// Drops the prepared case.
   void invalidateCase() { m_case.reset(); }
+  /// Drops the initial pose, the results and the ground truth after an input changed, emitting what changed.
+  void dropPoseAndResults();
 
   std::shared_ptr<const Volume> m_ct;
   std::filesystem::path m_ctPath;
@@ -221,8 +269,9 @@ class StudioDocument : public QObject {
   QString m_initialPoseSource;
   RoiParameters m_roi;
   StudioRegistrationOptions m_options;
-  std::optional<RegistrationResult> m_result;
-  ResultVerdict m_verdict = ResultVerdict::Undecided;
+  std::vector<StudioResult> m_results;
+  int m_currentResult = -1;
+  std::map<std::string, DisplayWindow> m_xrayWindows;
   std::optional<Eigen::Isometry3d> m_truthPose;
   bool m_modified = false;
   std::filesystem::path m_sessionPath;

@@ -15,6 +15,8 @@
 #include <QToolBox>
 #include <QVBoxLayout>
 
+#include <algorithm>
+
 #include "Widgets/DataStepWidget.h"
 #include "Widgets/LandmarkStepWidget.h"
 #include "Widgets/RegisterStepWidget.h"
@@ -55,7 +57,7 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   panelLayout->addWidget(heading);
   m_steps = new QToolBox(panel);
   panelLayout->addWidget(m_steps, 1);
-  panel->setMinimumWidth(360);
+  panel->setMinimumWidth(400);  // the ROI spin boxes fit without a scrollbar
 
   // Views (right): X-rays on top; slices and 3D below.
   auto* viewArea = new QWidget(this);
@@ -84,11 +86,8 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
     connect(slice, &SliceViewWidget::pointClicked, this, &StudioMainWindow::setCrosshair);
     connect(slice, &SliceViewWidget::crosshairMoved, this, &StudioMainWindow::setCrosshair);
     connect(slice, &SliceViewWidget::ctPointHovered, this, [this, slice](const Eigen::Vector3d& p, float value) {
-      m_hover->setText(tr("%1: L %2  P %3  S %4 mm  %5 HU")
-                           .arg(SliceViewWidget::orientationName(slice->orientation()))
-                           .arg(p.x(), 0, 'f', 1)
-                           .arg(p.y(), 0, 'f', 1)
-                           .arg(p.z(), 0, 'f', 1)
+      m_hover->setText(tr("%1: %2  %3 HU")
+                           .arg(SliceViewWidget::orientationName(slice->orientation()), SliceViewWidget::positionText(p))
                            .arg(value, 0, 'f', 0));
     });
   }
@@ -111,7 +110,7 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   splitter->addWidget(panel);
   splitter->addWidget(viewArea);
   splitter->setStretchFactor(1, 1);
-  splitter->setSizes({380, 1120});
+  splitter->setSizes({420, 1080});
   setCentralWidget(splitter);
 
   m_hover = new QLabel(this);
@@ -122,6 +121,13 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
     for (SliceViewWidget* slice : m_sliceViews) slice->setVolume(m_document->ct());
   });
   connect(m_document, &StudioDocument::viewsChanged, this, &StudioMainWindow::rebuildXrayViews);
+  connect(m_document, &StudioDocument::xrayWindowsChanged, this, [this] {
+    const auto& views = m_document->views();
+    for (std::size_t v = 0; v < m_xrayViews.size() && v < views.size(); ++v) {
+      const auto saved = m_document->xrayWindows().find(views[v].name);
+      if (saved != m_document->xrayWindows().end()) m_xrayViews[v]->setWindowLevel(saved->second.window, saved->second.level);
+    }
+  });
   connect(m_document, &StudioDocument::modifiedChanged, this, &StudioMainWindow::updateTitle);
   connect(m_autosave, &SessionAutosave::failed, this, [this](const QString& message) {
     showStatus(tr("Autosave failed: %1").arg(message));
@@ -138,8 +144,10 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   });
 
   m_dataStep = new DataStepWidget(m_document, this);
+  m_dataStep->setInputGuard([this] { return mayReplaceInputs(); });
   connect(m_dataStep, &DataStepWidget::statusMessage, this, &StudioMainWindow::showStatus);
   connect(m_dataStep, &DataStepWidget::loadFinished, this, [this](bool ok, const QString& message) {
+    updateTitle();
     if (ok) {
       m_messageBar->hide();
     } else {
@@ -150,7 +158,8 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   addStep(tr("Data"), m_dataStep);
   addStep(tr("Initial pose"), new LandmarkStepWidget(m_document, this));
   addStep(tr("ROIs"), new RoiStepWidget(m_document, this));
-  addStep(tr("Register"), new RegisterStepWidget(m_document, this));
+  auto* registration = addStep(tr("Register"), new RegisterStepWidget(m_document, this));
+  connect(registration, &RegisterStepWidget::statusMessage, this, &StudioMainWindow::showStatus);
   addStep(tr("Review"), new ReviewStepWidget(m_document, this));
 
   buildMenus();
@@ -220,6 +229,13 @@ void StudioMainWindow::buildMenus() {
   view->addAction(tr("CT window: &soft tissue"), this, [this] {
     for (SliceViewWidget* slice : m_sliceViews) slice->applyWindowPreset(SliceWindowPreset::SoftTissue);
   });
+  for (const XrayWindowPreset preset :
+       {XrayWindowPreset::Automatic, XrayWindowPreset::WholeField, XrayWindowPreset::FullRange}) {
+    view->addAction(tr("X-ray window: %1").arg(XrayViewWidget::presetName(preset)), this, [this, preset] {
+      for (XrayViewWidget* xray : m_xrayViews) xray->applyWindowPreset(preset);
+    });
+  }
+  view->addSeparator();
   view->addAction(tr("&Reset views"), this, [this] {
     for (SliceViewWidget* slice : m_sliceViews) slice->resetView();
     for (XrayViewWidget* xray : m_xrayViews) xray->resetView();
@@ -247,6 +263,12 @@ void StudioMainWindow::rebuildXrayViews() {
     auto* widget = new XrayViewWidget(m_xrayRow);
     widget->setTitle(QString::fromStdString(view.name));
     widget->setImage(view.xray);
+    if (const auto saved = m_document->xrayWindows().find(view.name); saved != m_document->xrayWindows().end()) {
+      widget->setWindowLevel(saved->second.window, saved->second.level);
+    }
+    connect(widget, &ImageViewWidget::windowLevelChanged, this, [this, name = view.name](double window, double level) {
+      m_document->setXrayWindow(name, {window, level});
+    });
     const QString name = QString::fromStdString(view.name);
     connect(widget, &ImageViewWidget::pixelHovered, this, [this, name](const Eigen::Vector2d& uv, float value) {
       m_hover->setText(tr("%1: pixel (%2, %3)  value %4").arg(name).arg(uv.x(), 0, 'f', 1).arg(uv.y(), 0, 'f', 1).arg(value));
@@ -316,7 +338,7 @@ bool StudioMainWindow::saveSession() {
 }
 
 bool StudioMainWindow::saveSessionAs() {
-  QString path = QFileDialog::getSaveFileName(this, tr("Save the session"), tr("session.fctsession.json"),
+  QString path = QFileDialog::getSaveFileName(this, tr("Save the session"), m_document->suggestedPath(tr("session.fctsession.json")),
                                               tr("FluoroCT sessions (*.fctsession.json)"));
   if (path.isEmpty()) return false;
   if (!path.endsWith(QStringLiteral(".json"))) path += QString::fromLatin1(StudioSession::kSuffix);
@@ -368,14 +390,41 @@ void StudioMainWindow::offerAutosave() {
   }
 }
 
-bool StudioMainWindow::maybeSave() {
+QString StudioMainWindow::contentSummary() const {
+  const StudioDocument& d = *m_document;
+  QStringList parts;
+  if (d.ct()) parts << tr("the CT %1").arg(qs(d.ctPath().filename()));
+  if (!d.views().empty()) parts << tr("%n X-ray view(s)", nullptr, static_cast<int>(d.views().size()));
+  if (!d.landmarks().ct.empty()) parts << tr("%n landmark(s)", nullptr, static_cast<int>(d.landmarks().ct.size()));
+  if (d.initialPose()) parts << tr("an initial pose (%1)").arg(d.initialPoseSource());
+  if (!d.results().empty()) {
+    const auto accepted = std::count_if(d.results().begin(), d.results().end(), [](const StudioResult& r) {
+      return r.verdict == ResultVerdict::Accepted;
+    });
+    parts << tr("%n registration result(s)", nullptr, static_cast<int>(d.results().size())) +
+                 (accepted > 0 ? tr(" (%n accepted)", nullptr, static_cast<int>(accepted)) : QString());
+  }
+  return parts.isEmpty() ? tr("nothing yet") : parts.join(QStringLiteral(", "));
+}
+
+bool StudioMainWindow::maybeSave() { return askToSave({}); }
+
+bool StudioMainWindow::askToSave(const QString& lead) {
   if (!m_document->isModified()) return true;
-  const auto answer = QMessageBox::warning(this, tr("Unsaved changes"),
-                                           tr("The session has unsaved changes. Save them first?"),
-                                           QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,
-                                           QMessageBox::Save);
+  const QString name = m_document->sessionPath().empty() ? tr("The untitled session")
+                                                         : tr("The session %1").arg(qs(m_document->sessionPath().filename()));
+  const auto answer = QMessageBox::warning(
+      this, tr("Unsaved changes"),
+      lead + tr("%1 has unsaved changes. It holds %2.\n\nSave it first?").arg(name, contentSummary()),
+      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
   if (answer == QMessageBox::Save) return saveSession();
   return answer == QMessageBox::Discard;
+}
+
+bool StudioMainWindow::mayReplaceInputs() {
+  if (!m_document->hasDerivedState()) return true;
+  return askToSave(tr("New images replace the current ones: their landmarks, initial pose and registration results "
+                      "are dropped.\n\n"));
 }
 
 void StudioMainWindow::closeEvent(QCloseEvent* event) {
@@ -386,6 +435,8 @@ void StudioMainWindow::closeEvent(QCloseEvent* event) {
   m_autosave->discard();
   event->accept();
 }
+
+QString StudioMainWindow::hoverText() const { return m_hover->text(); }
 
 QStringList StudioMainWindow::recentSessions() const { return QSettings().value(kRecentKey).toStringList(); }
 

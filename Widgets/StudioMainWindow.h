@@ -74,6 +74,8 @@ class StudioMainWindow : public QMainWindow {
   /// The autosave of the document.
   SessionAutosave* autosave() const { return m_autosave; }
 
+  /// The position readout of the status line (CT point and value, or X-ray pixel and value), as shown.
+  QString hoverText() const;
   /// The last message shown in the message bar or status line.
   const QString& lastMessage() const { return m_lastMessage; }
   /// Recent session files, most recent first (QSettings "recentSessions").
@@ -100,8 +102,14 @@ class StudioMainWindow : public QMainWindow {
   bool restoreAutosave();
   /// If an autosave side file exists, asks whether to restore it (restore or discard it). Call once at start-up.
   void offerAutosave();
-  /// Asks whether to save unsaved changes (Save / Discard / Cancel). True when it is fine to drop the session.
+  /// Asks whether to save unsaved changes (Save / Discard / Cancel), saying what the session holds. True when it is
+  /// fine to drop the session.
   bool maybeSave();
+  /// Before an input (CT, views) is replaced: when unsaved work derived from the inputs (landmarks, initial pose,
+  /// results) would be dropped, asks as maybeSave() does. True when the inputs may change.
+  bool mayReplaceInputs();
+  /// What the session holds, in words ("the CT ct.nrrd, 2 X-ray views, 4 landmarks, …"), for the save questions.
+  QString contentSummary() const;
   /// Shows an error in the message bar above the views and the status line.
   void showError(const QString& message);
   /// Shows a message in the status line.
@@ -116,6 +124,8 @@ class StudioMainWindow : public QMainWindow {
     std::function<void(const std::vector<XrayViewWidget*>&, const std::array<SliceViewWidget*, 3>&)> attachViews;
   };
   void addStepWidget(const QString& title, QWidget* step, StepHooks hooks);
+  /// maybeSave() with `lead` (a paragraph saying why it asks) before the question.
+  bool askToSave(const QString& lead);
   void buildMenus();
   /// Rebuilds the X-ray views from the document's views and re-attaches them to the steps.
   void rebuildXrayViews();

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <array>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string_view>
 #include <utility>
@@ -21,8 +22,9 @@ namespace fs = std::filesystem;
 using ordered_json = nlohmann::ordered_json;
 
 constexpr const char* kFormat = "fluoroct-studio-session";
-/// Version 2 embeds the result as a RegistrationResultJson object; version 1 (its own result keys) is read too.
-constexpr int kVersion = 2;
+/// Version 3 keeps the result history ("results", "current_result") and the X-ray windows ("display"); versions 2 (one
+/// "result", a RegistrationResultJson object) and 1 (one "result" in its own keys) are read too.
+constexpr int kVersion = 3;
 
 /// A path as written into a file in `folder`: relative when inside it, else absolute. Empty folder: absolute.
 std::string storedPath(const fs::path& path, const fs::path& folder) {
@@ -97,7 +99,17 @@ ordered_json sessionJson(const StudioDocument& d, const fs::path& folder) {
                  {"sphere_margin_px", roi.sphereMargin_px}};
   const StudioRegistrationOptions& options = d.registrationOptions();
   json["registration"] = {{"preset", options.preset}, {"seed", options.seed}, {"drr_method", options.drrMethod}};
-  if (d.result()) json["result"] = resultJson(*d.result(), d.resultVerdict());
+  if (!d.results().empty()) {
+    ordered_json results = ordered_json::array();
+    for (const StudioResult& entry : d.results()) results.push_back(resultJson(entry.result, entry.verdict));
+    json["results"] = std::move(results);
+    json["current_result"] = d.currentResultIndex();
+  }
+  if (!d.xrayWindows().empty()) {
+    ordered_json windows = ordered_json::object();
+    for (const auto& [view, w] : d.xrayWindows()) windows[view] = {{"window", w.window}, {"level", w.level}};
+    json["display"] = {{"xray_windows", std::move(windows)}};
+  }
   if (d.truthPose()) json["truth_pose"] = {{"T_world_from_ct", pose(*d.truthPose())}};
   return json;
 }
@@ -111,8 +123,9 @@ struct SessionContent {
   QString initialPoseSource;
   RoiParameters roi;
   StudioRegistrationOptions options;
-  std::optional<RegistrationResult> result;
-  ResultVerdict verdict = ResultVerdict::Undecided;
+  std::vector<StudioResult> results;
+  int currentResult = -1;
+  std::map<std::string, DisplayWindow> xrayWindows;
   std::optional<Eigen::Isometry3d> truthPose;
   fs::path autosaveOf;
   bool isAutosave = false;
@@ -275,17 +288,61 @@ Status readRegistrationSection(const nlohmann::json& section, const SessionFile&
   return Ok{};
 }
 
-/// "result": the last result (the RegistrationResultJson object, version 1 or 2) and the user's verdict beside it.
+/// One result (the RegistrationResultJson object, version 1 or 2) with the user's verdict beside it, read at `where`.
 /// Fails naming the key with a bad value.
-Status readResultSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
-  const std::string where = file.where + ": result";
+Result<StudioResult> readResult(const nlohmann::json& section, const std::string& where) {
   JsonReader reader(section, where);
-  content.verdict =
+  const ResultVerdict verdict =
       readNamed(reader, "verdict", kVerdicts, "accepted, rejected or undecided").value_or(ResultVerdict::Undecided);
   if (!reader.ok()) return fail(reader.error());
   auto result = RegistrationResultJson::read(section, where);
   if (!result) return fail(result.error());
-  content.result = std::move(result).value();
+  return StudioResult{std::move(result).value(), verdict};
+}
+
+/// "result" (session versions 1 and 2): the one result, which becomes a history of one. Fails as readResult.
+Status readResultSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  auto read = readResult(section, file.where + ": result");
+  if (!read) return fail(read.error());
+  content.results = {std::move(read).value()};
+  content.currentResult = 0;
+  return Ok{};
+}
+
+/// "results" (version 3): the result history, oldest first. Fails naming the entry.
+Status readResultsSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  if (!section.is_array()) return fail(file.where + ": results must be an array of results");
+  content.results.clear();
+  for (std::size_t i = 0; i < section.size(); ++i) {
+    auto read = readResult(section[i], fmt::format("{}: results[{}]", file.where, i));
+    if (!read) return fail(read.error());
+    content.results.push_back(std::move(read).value());
+  }
+  content.currentResult = static_cast<int>(content.results.size()) - 1;
+  return Ok{};
+}
+
+/// "current_result": the index into "results" of the result shown. Fails naming the key when out of range.
+Status readCurrentResultSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  const int count = static_cast<int>(content.results.size());
+  if (!section.is_number_integer() || section.get<int>() < 0 || section.get<int>() >= count) {
+    return fail(fmt::format("{}: current_result must be an index into results (0 to {})", file.where, count - 1));
+  }
+  content.currentResult = section.get<int>();
+  return Ok{};
+}
+
+/// "display": the X-ray windows {<view>: {window, level}}. Fails naming the view with a bad value.
+Status readDisplaySection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
+  JsonReader display(section, file.where + ": display");
+  const nlohmann::json* windows = display.find("xray_windows");
+  if (!windows || !windows->is_object()) return Ok{};
+  for (const auto& [view, value] : windows->items()) {
+    JsonReader w(value, fmt::format("{}: display.xray_windows.{}", file.where, view));
+    const DisplayWindow window{w.positiveNumber("window"), w.number("level")};
+    if (!w.ok()) return fail(w.error());
+    content.xrayWindows[view] = window;
+  }
   return Ok{};
 }
 
@@ -301,7 +358,7 @@ Status readTruthPoseSection(const nlohmann::json& section, const SessionFile& fi
 using SectionReader = Status (*)(const nlohmann::json& section, const SessionFile& file, SessionContent& content);
 
 /// The optional sections in the order they are read: the first one that fails ends the read.
-constexpr std::array<std::pair<std::string_view, SectionReader>, 8> kSections{{
+constexpr std::array<std::pair<std::string_view, SectionReader>, 11> kSections{{
     {"ct", readCtSection},
     {"views", readViewsSection},
     {"landmarks", readLandmarksSection},
@@ -309,6 +366,9 @@ constexpr std::array<std::pair<std::string_view, SectionReader>, 8> kSections{{
     {"roi", readRoiSection},
     {"registration", readRegistrationSection},
     {"result", readResultSection},
+    {"results", readResultsSection},
+    {"current_result", readCurrentResultSection},
+    {"display", readDisplaySection},
     {"truth_pose", readTruthPoseSection},
 }};
 
@@ -365,10 +425,8 @@ Status StudioSession::open(StudioDocument& document, const fs::path& path) {
   if (content.initialPose) document.setInitialPose(content.initialPose, content.initialPoseSource);
   document.setRoiParameters(content.roi);
   document.setRegistrationOptions(content.options);
-  if (content.result) {
-    document.setResult(std::move(content.result));
-    document.setResultVerdict(content.verdict);
-  }
+  document.setResults(std::move(content.results), content.currentResult);
+  for (const auto& [view, window] : content.xrayWindows) document.setXrayWindow(view, window);
   document.setTruthPose(content.truthPose);
   document.setSessionPath(content.isAutosave ? content.autosaveOf : path);
   document.setModified(content.isAutosave);

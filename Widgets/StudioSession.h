@@ -1,9 +1,10 @@
 #pragma once
 // StudioSession: the session file of FluoroCT Studio (JSON, docs/file-formats.md "Studio session file"): the inputs
 // (CT path and series, view file or X-ray files), landmarks, initial pose, ROI parameters, registration options, the
-// last result (the RegistrationResultJson object of RESULT.json) with the user's verdict, and the ground truth. The
-// CT and X-rays are referenced by path, not copied. Paths inside the session's folder are written relative to it.
-// Files are written atomically (temporary file, then rename). Version 2 is written; version 1 is read too.
+// result history (each a RegistrationResultJson object of RESULT.json with the user's verdict) and the current one,
+// the X-ray windows, and the ground truth. The CT and X-rays are referenced by path, not copied. Paths inside the
+// session's folder are written relative to it.
+// Files are written atomically (temporary file, then rename). Version 3 is written; versions 1 and 2 are read too.
 // An autosave file has the same schema plus "autosave_of", the session file it belongs to (may be empty).
 
 #include <filesystem>

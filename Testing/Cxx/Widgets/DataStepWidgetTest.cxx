@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <QHeaderView>
 #include <QSignalSpy>
+#include <QTableWidget>
 #include <QTest>
 
 #include <fstream>
@@ -40,6 +42,9 @@ TEST(DataStepWidget, LoadsTheBuiltinCaseFolderAndDescribesIt) {
   EXPECT_TRUE(document.truthPose().has_value());
   const QString summary = step.summaryText();
   EXPECT_TRUE(summary.contains(QStringLiteral("96 × 96 × 72 voxels"))) << summary.toStdString();
+  EXPECT_TRUE(summary.contains(QStringLiteral("Initial pose from pose file initial_pose.json"))) << summary.toStdString();
+  EXPECT_EQ(document.suggestedPath(QStringLiteral("pose.tfm")), QString::fromStdString((dir / "pose.tfm").string()))
+      << "export dialogs start in the case folder";
   EXPECT_TRUE(summary.contains(QStringLiteral("Ground truth"))) << summary.toStdString();
   EXPECT_TRUE(step.errorText().isEmpty());
 }
@@ -170,6 +175,26 @@ TEST(DataStepWidget, OpensThePelvisVolumeFile) {
   ASSERT_TRUE(ok) << message.toStdString();
   ASSERT_TRUE(document.ct());
   EXPECT_TRUE(step.summaryText().contains(QStringLiteral("pelvis_totalseg.nii.gz")));
+}
+
+TEST(DataStepWidget, TheSidColumnIsNotClippedInTheStepsWidth) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  StudioDocument document;
+  DataStepWidget step(&document);
+  step.resize(360, 600);  // the module panel's minimum width
+  step.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&step));
+  ASSERT_TRUE(document.loadViews(dir / "views.json").ok());
+  QTest::qWait(20);
+  auto* table = step.findChild<QTableWidget*>();
+  ASSERT_NE(table, nullptr);
+  const QHeaderView* header = table->horizontalHeader();
+  const int sid = header->logicalIndex(4);
+  EXPECT_EQ(table->horizontalHeaderItem(sid)->text(), QStringLiteral("SID (mm)"));
+  EXPECT_LE(header->sectionViewportPosition(sid) + header->sectionSize(sid), table->viewport()->width())
+      << "the SID column ends inside the table";
+  EXPECT_GE(header->sectionSize(sid), header->fontMetrics().horizontalAdvance(QStringLiteral("SID (mm)")));
 }
 
 }  // namespace

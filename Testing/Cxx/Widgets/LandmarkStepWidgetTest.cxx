@@ -3,6 +3,7 @@
 // round-trip; the setup preset and the table edits work.
 #include <gtest/gtest.h>
 
+#include <QHeaderView>
 #include <QTableWidget>
 
 #include "IO/Project/LandmarkFile.h"
@@ -134,4 +135,147 @@ TEST(LandmarkStepWidget, SupineApPresetPutsTheBoneAtTheIsocentre) {
   // The simulated views look at the world origin; the bone centroid goes there.
   EXPECT_LT((*session.document.initialPose() * session.bone->centroid_ct_mm()).norm(), 1e-6);
   EXPECT_EQ(session.document.initialPoseSource(), QStringLiteral("preset supine AP"));
+}
+
+namespace {
+
+/// Places landmark i (of `targets`) in the CT and, for each listed view, at its true projection.
+void placeLandmark(fct::test::StepTestSession& session, fct::LandmarkStepWidget& step, const Eigen::Vector3d& target,
+                   std::initializer_list<int> views) {
+  step.addCtLandmark(target);
+  for (int v : views) {
+    step.setImagePoint(v, session.document.views()[static_cast<std::size_t>(v)].camera.project(session.T_truth * target));
+  }
+}
+
+}  // namespace
+
+TEST(LandmarkStepWidget, StatesTheRuleAndSaysPerLandmarkAndViewWhatIsMissing) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::LandmarkStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  EXPECT_TRUE(fct::LandmarkStepWidget::ruleText().contains(QStringLiteral("4 of them clicked in the same view")));
+  const auto targets = session.spreadBonePoints();
+  ASSERT_GE(targets.size(), 5u);
+  // 4 landmarks, 2 in each of two views: the stated "4 landmarks" rule alone is not enough.
+  placeLandmark(session, step, targets[0], {0});
+  placeLandmark(session, step, targets[1], {0});
+  placeLandmark(session, step, targets[2], {1});
+  placeLandmark(session, step, targets[3], {1});
+  placeLandmark(session, step, targets[4], {});
+  const QString missing = step.missingText();
+  EXPECT_TRUE(missing.contains(QStringLiteral("click L5 in an X-ray view"))) << missing.toStdString();
+  EXPECT_TRUE(missing.contains(QStringLiteral("2 more landmark(s) in view"))) << missing.toStdString();
+  EXPECT_TRUE(missing.contains(QStringLiteral("Clicked per view: ") + QString::fromStdString(session.document.views()[0].name) +
+                               QStringLiteral(" 2")))
+      << missing.toStdString();
+  EXPECT_FALSE(step.computePose());
+  EXPECT_TRUE(step.message().contains(QStringLiteral("To do: click L5"))) << step.message().toStdString();
+  EXPECT_FALSE(session.document.initialPose());
+  // Two more clicks in view 0 (L3, L4) meet the rule: nothing missing, and the pose is computed.
+  step.selectLandmark(QStringLiteral("L5"));
+  step.deleteLandmark(QStringLiteral("L5"));
+  EXPECT_EQ(step.message(), QStringLiteral("Deleted L5 (Ctrl+Z brings it back)."));
+  for (int i : {2, 3}) {
+    step.selectLandmark(QStringLiteral("L%1").arg(i + 1));
+    step.setImagePoint(0, session.document.views()[0].camera.project(session.T_truth * targets[static_cast<std::size_t>(i)]));
+  }
+  EXPECT_TRUE(step.missingText().isEmpty()) << step.missingText().toStdString();
+  EXPECT_TRUE(step.computePose()) << step.message().toStdString();
+  auto* header = step.table()->horizontalHeaderItem(3);
+  EXPECT_TRUE(step.table()->item(0, 3)->text().endsWith(QStringLiteral(" px"))) << "units in every residual";
+  EXPECT_GE(step.table()->horizontalHeader()->sectionSize(3),
+            step.table()->horizontalHeader()->fontMetrics().horizontalAdvance(header->text()))
+      << "the residual header is not clipped";
+}
+
+TEST(LandmarkStepWidget, SelectingARowJumpsTheSlicesAndEmptyTableSpaceDeselects) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::LandmarkStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  step.resize(420, 500);
+  step.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&step));
+  const auto targets = session.spreadBonePoints();
+  ASSERT_GE(targets.size(), 2u);
+  session.clickCt(targets[0]);
+  session.clickCt(targets[1]);
+  const Eigen::Vector3d first = session.document.landmarks().ct[0].p_ct_mm;
+  QTableWidget* table = step.table();
+  const QRect cell = table->visualItemRect(table->item(0, 1));
+  QTest::mouseClick(table->viewport(), Qt::LeftButton, Qt::NoModifier, cell.center());
+  EXPECT_EQ(step.selectedLandmark(), QStringLiteral("L1"));
+  for (fct::SliceViewWidget* view : session.sliceViews) {
+    EXPECT_LT((view->crosshair_ct_mm() - first).norm(), 1e-9) << "every slice view shows L1";
+  }
+  QTest::mouseClick(table->viewport(), Qt::LeftButton, Qt::NoModifier, QPoint(10, table->viewport()->height() - 5));
+  EXPECT_TRUE(step.selectedLandmark().isEmpty()) << "a click below the rows deselects";
+}
+
+TEST(LandmarkStepWidget, UndoRestoresAMovedLandmarkAndAStrayClickMovesNothing) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::LandmarkStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  const auto targets = session.spreadBonePoints();
+  ASSERT_GE(targets.size(), 1u);
+  session.clickCt(targets[0]);
+  session.clickTrueProjection(0, targets[0]);
+  const Eigen::Vector2d placed = session.document.landmarks().imageByView.at(session.document.views()[0].name)[0].uv_px;
+  fct::XrayViewWidget* view = session.xrayViews[0];
+
+  // Nothing selected: a click on the partner's marker (with a 2-pixel jitter) selects it and does not move it.
+  step.selectLandmark({});
+  const QPoint marker = view->widgetPointForPixel(placed);
+  QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, marker);
+  QTest::mouseMove(view, marker + QPoint(2, 1));
+  QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, marker + QPoint(2, 1));
+  EXPECT_TRUE(session.document.landmarks().imageByView.at(session.document.views()[0].name)[0].uv_px.isApprox(placed));
+  EXPECT_EQ(step.selectedLandmark(), QStringLiteral("L1"));
+
+  // A real drag moves it; one undo puts it back, redo moves it again.
+  QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, marker);
+  QTest::mouseMove(view, marker + QPoint(15, 0));
+  QTest::mouseMove(view, marker + QPoint(30, 10));
+  QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, marker + QPoint(30, 10));
+  const auto uvNow = [&] { return session.document.landmarks().imageByView.at(session.document.views()[0].name)[0].uv_px; };
+  const Eigen::Vector2d dragged = uvNow();
+  ASSERT_GT((dragged - placed).norm(), 3.0);
+  step.undo();
+  EXPECT_TRUE(uvNow().isApprox(placed, 1e-9)) << "one undo for the whole drag";
+  step.redo();
+  EXPECT_TRUE(uvNow().isApprox(dragged, 1e-9));
+
+  // Every edit undoes: the CT drag, the delete and the add.
+  step.moveCtLandmark(QStringLiteral("L1"), targets[0] + Eigen::Vector3d(3.0, 0.0, 0.0));
+  step.deleteLandmark(QStringLiteral("L1"));
+  EXPECT_TRUE(session.document.landmarks().ct.empty());
+  step.undo();
+  ASSERT_EQ(session.document.landmarks().ct.size(), 1u);
+  EXPECT_NEAR(session.document.landmarks().ct[0].p_ct_mm.x(), targets[0].x() + 3.0, 2.0);
+  step.undo();
+  step.undo();
+  step.undo();
+  EXPECT_TRUE(session.document.landmarks().imageByView.empty() ||
+              session.document.landmarks().imageByView.begin()->second.empty());
+  step.undo();
+  EXPECT_TRUE(session.document.landmarks().ct.empty()) << "back to before the first click";
+}
+
+TEST(LandmarkStepWidget, CtrlZInTheWindowUndoesTheLastEdit) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  auto* step = new fct::LandmarkStepWidget(&session.document, session.window.get());
+  step->attachViews(session.xrayViews, session.sliceViews);
+  step->setActive(true);
+  step->show();  // shortcuts of hidden widgets do not fire
+  session.window->activateWindow();
+  ASSERT_TRUE(QTest::qWaitForWindowActive(session.window.get()));
+  step->addCtLandmark(session.document.ct()->centre_lps_mm());
+  ASSERT_EQ(session.document.landmarks().ct.size(), 1u);
+  QTest::keyClick(session.window.get(), Qt::Key_Z, Qt::ControlModifier);
+  EXPECT_TRUE(session.document.landmarks().ct.empty()) << step->message().toStdString();
+  QTest::keyClick(session.window.get(), Qt::Key_Z, Qt::ControlModifier | Qt::ShiftModifier);
+  EXPECT_EQ(session.document.landmarks().ct.size(), 1u) << step->message().toStdString();
 }

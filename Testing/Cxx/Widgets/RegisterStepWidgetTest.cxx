@@ -3,6 +3,9 @@
 // missing initial pose is refused with a message.
 #include <gtest/gtest.h>
 
+#include <QPushButton>
+#include <QSignalSpy>
+
 #include "Evaluation/PoseOffset.h"
 #include "StepTestSession.h"
 #include "Widgets/RegisterStepWidget.h"
@@ -24,8 +27,16 @@ TEST(RegisterStepWidget, FastRunOnItsThreadEndsWithinOneMillimetre) {
   ASSERT_TRUE(step.run()) << step.message().toStdString();
   EXPECT_TRUE(step.isRunning());
   EXPECT_FALSE(step.run()) << "one run at a time";
-  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000)) << "the run ends";
-  ASSERT_TRUE(session.document.result().has_value()) << step.message().toStdString();
+  bool sawTimeLeft = false;
+  ASSERT_TRUE(fct::test::waitUntil(
+      [&] {
+        sawTimeLeft = sawTimeLeft || step.progressText().contains(QStringLiteral("s left"));
+        return !step.isRunning();
+      },
+      120000))
+      << "the run ends";
+  EXPECT_TRUE(sawTimeLeft) << "the progress line estimates the time left";
+  ASSERT_TRUE(session.document.result() != nullptr) << step.message().toStdString();
   const fct::RegistrationResult& result = *session.document.result();
   EXPECT_FALSE(result.cancelled);
   EXPECT_EQ(result.stages.size(), 4u) << "the fast preset's stages";
@@ -34,6 +45,7 @@ TEST(RegisterStepWidget, FastRunOnItsThreadEndsWithinOneMillimetre) {
   std::printf("fast registration from 5 mm via the Register step: %.3f mm, %ld DRRs\n", error_mm, result.totalDrrs);
   EXPECT_LT(error_mm, 1.0);
   EXPECT_NE(step.logText().indexOf(QStringLiteral("Registered")), -1);
+  EXPECT_NE(step.logText().indexOf(QStringLiteral("Coarse alignment (whole images)")), -1) << "stages in words";
 }
 
 TEST(RegisterStepWidget, CancelMidRunKeepsTheBestPoseMarkedAndTheWidgetRunsAgain) {
@@ -48,7 +60,7 @@ TEST(RegisterStepWidget, CancelMidRunKeepsTheBestPoseMarkedAndTheWidgetRunsAgain
   ASSERT_TRUE(fct::test::waitUntil([&] { return step.lastProgress().drrs > 0; }, 60000)) << "progress arrives";
   step.cancel();
   ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 60000)) << "cancelling ends the run";
-  ASSERT_TRUE(session.document.result().has_value());
+  ASSERT_TRUE(session.document.result() != nullptr);
   const fct::RegistrationResult& cancelled = *session.document.result();
   EXPECT_TRUE(cancelled.cancelled);
   EXPECT_LE(session.surfaceError_mm(cancelled.T_world_from_ct), session.surfaceError_mm(start) + 1e-6)
@@ -59,7 +71,7 @@ TEST(RegisterStepWidget, CancelMidRunKeepsTheBestPoseMarkedAndTheWidgetRunsAgain
   session.document.setRegistrationOptions(options);
   ASSERT_TRUE(step.run()) << step.message().toStdString();
   ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000));
-  ASSERT_TRUE(session.document.result().has_value());
+  ASSERT_TRUE(session.document.result() != nullptr);
   EXPECT_FALSE(session.document.result()->cancelled);
 }
 
@@ -80,7 +92,7 @@ TEST(RegisterStepWidget, RefusesToRunWithoutAnInitialPoseOrWithABadPreset) {
   session.document.setRegistrationOptions(options);
   EXPECT_FALSE(step.run());
   EXPECT_NE(step.message().indexOf(QStringLiteral("Preset")), -1) << step.message().toStdString();
-  EXPECT_FALSE(session.document.result().has_value());
+  EXPECT_EQ(session.document.result(), nullptr);
 }
 
 TEST(RegisterStepWidget, DestroyingTheWidgetDuringARunCancelsItCleanly) {
@@ -89,7 +101,7 @@ TEST(RegisterStepWidget, DestroyingTheWidgetDuringARunCancelsItCleanly) {
   auto step = std::make_unique<fct::RegisterStepWidget>(&session.document);
   ASSERT_TRUE(step->run());
   step.reset();
-  EXPECT_FALSE(session.document.result().has_value()) << "a run cut short by closing stores nothing";
+  EXPECT_EQ(session.document.result(), nullptr) << "a run cut short by closing stores nothing";
 }
 
 TEST(RegisterStepWidget, AResultOfViewsReplacedDuringTheRunIsNotKept) {
@@ -99,7 +111,7 @@ TEST(RegisterStepWidget, AResultOfViewsReplacedDuringTheRunIsNotKept) {
   ASSERT_TRUE(step.run()) << step.message().toStdString();
   session.document.setViews(session.document.views());
   ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000));
-  EXPECT_FALSE(session.document.result().has_value());
+  EXPECT_EQ(session.document.result(), nullptr);
   EXPECT_NE(step.message().indexOf(QStringLiteral("changed during the run")), -1) << step.message().toStdString();
 }
 
@@ -116,4 +128,34 @@ TEST(RegisterStepWidget, EveryAblationSwitchIncludingTheTransgraphRoundTrips) {
   onlyTransgraphOff.noTransgraph = true;
   step.setAblation(onlyTransgraphOff);
   EXPECT_EQ(step.ablation().activeNames(), std::vector<std::string>{"no-transgraph"});
+}
+
+TEST(RegisterStepWidget, StagesHavePlainNamesAndMessagesReachTheStatusLine) {
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("ncc-whole-1:16"),
+            QStringLiteral("Coarse alignment (whole images) [ncc-whole-1:16]"));
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("vlnc-rois-1:4"),
+            QStringLiteral("Refinement (bone edges, 1:4) [vlnc-rois-1:4]"));
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("vlnc-rois-1:1"), QStringLiteral("Final (full resolution) [vlnc-rois-1:1]"));
+  EXPECT_EQ(fct::RegisterStepWidget::plainStageName("custom"), QStringLiteral("Refinement (bone edges) [custom]"));
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  QSignalSpy status(&step, &fct::RegisterStepWidget::statusMessage);
+  step.setActive(true);
+  ASSERT_EQ(status.count(), 1);
+  EXPECT_TRUE(status.at(0).at(0).toString().startsWith(QStringLiteral("No initial pose"))) << "the status line follows";
+}
+
+TEST(RegisterStepWidget, RunIsDisabledWithoutDataAndItsTooltipSaysWhatIsMissing) {
+  fct::StudioDocument empty;
+  fct::RegisterStepWidget idle(&empty);
+  EXPECT_FALSE(idle.runButton()->isEnabled());
+  EXPECT_TRUE(idle.runButton()->toolTip().contains(QStringLiteral("a CT (Data step)"))) << idle.runButton()->toolTip().toStdString();
+  EXPECT_TRUE(idle.runButton()->toolTip().contains(QStringLiteral("an initial pose")));
+  EXPECT_FALSE(idle.run());
+  EXPECT_TRUE(idle.message().contains(QStringLiteral("X-ray views"))) << idle.message().toStdString();
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  EXPECT_FALSE(step.runButton()->isEnabled()) << "no initial pose yet";
+  setStartPose(session, 3.0);
+  EXPECT_TRUE(step.runButton()->isEnabled());
 }

@@ -40,7 +40,7 @@ bool clickSendAndWait(fct::ReviewStepWidget& step) {
 TEST(ReviewStepWidget, SendToSlicerDeliversTheFinalPoseInRas) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   const fct::RegistrationResult result = tiltedResult(session.T_truth);
-  session.document.setResult(result);
+  session.document.addResult(result);
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
@@ -68,7 +68,7 @@ TEST(ReviewStepWidget, SendToSlicerShowsARefusedConnectionAndAMissingResult) {
   EXPECT_FALSE(clickSendAndWait(step));
   EXPECT_NE(step.message().indexOf(QStringLiteral("No registration result to send")), -1) << step.message().toStdString();
 
-  session.document.setResult(tiltedResult(session.T_truth));
+  session.document.addResult(tiltedResult(session.T_truth));
   EXPECT_FALSE(clickSendAndWait(step));
   EXPECT_NE(step.message().indexOf(QStringLiteral("Not sent to 3D Slicer")), -1) << step.message().toStdString();
   EXPECT_NE(step.message().indexOf(QStringLiteral("connection refused")), -1) << step.message().toStdString();

@@ -2,6 +2,7 @@
 // truth, the verdict, and the exports (.tfm and JSON read back equal; screenshot PNG readable).
 #include <gtest/gtest.h>
 
+#include <QComboBox>
 #include <QImage>
 
 #include "Evaluation/PoseOffset.h"
@@ -26,7 +27,7 @@ fct::RegistrationResult resultAt(const fct::test::StepTestSession& session, cons
 
 TEST(ReviewStepWidget, DrawsBothOutlinesAndTheDrrAndShowsTheSurfaceError) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
-  session.document.setResult(resultAt(session, session.T_truth));
+  session.document.addResult(resultAt(session, session.T_truth));
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
@@ -57,7 +58,7 @@ TEST(ReviewStepWidget, AcceptRejectAndExportsReadBack) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   const Eigen::Isometry3d finalPose =
       fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, 0.5, 9).value();
-  session.document.setResult(resultAt(session, finalPose));
+  session.document.addResult(resultAt(session, finalPose));
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
@@ -92,7 +93,7 @@ TEST(ReviewStepWidget, ExportsTheFinalPoseAsADicomRegistration) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   const Eigen::Isometry3d finalPose =
       fct::PoseOffset::randomAtSurfaceDistance(*session.bone, session.T_truth, 0.5, 9).value();
-  session.document.setResult(resultAt(session, finalPose));
+  session.document.addResult(resultAt(session, finalPose));
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   const auto dir = fct::test::scratchDir();
@@ -121,4 +122,57 @@ TEST(ReviewStepWidget, WithoutAResultExportIsRefusedWithAMessage) {
   EXPECT_FALSE(std::filesystem::exists(dir / "reg.dcm"));
   step.acceptResult();
   EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided);
+}
+
+TEST(ReviewStepWidget, OutlinesAreDrawnOverTheCheckerboardAndTheBlend) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  session.document.addResult(resultAt(session, session.T_truth));
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  step.setShowInitial(false);
+  step.setContourColours(QColor(255, 0, 255), QColor(255, 0, 255));  // a colour neither the X-ray nor the DRR has
+  fct::XrayViewWidget* view = session.xrayViews[0];
+  const auto magentaPixels = [view] {
+    const QImage shot = view->grab().toImage();
+    int count = 0;
+    for (int y = 0; y < shot.height(); ++y) {
+      for (int x = 0; x < shot.width(); ++x) {
+        const QColor c = shot.pixelColor(x, y);
+        if (c.red() > 200 && c.blue() > 200 && c.green() < 80) ++count;
+      }
+    }
+    return count;
+  };
+  const int alone = magentaPixels();
+  ASSERT_GT(alone, 50) << "the final outline is drawn";
+  for (const auto mode : {fct::ReviewStepWidget::DrrMode::Checkerboard, fct::ReviewStepWidget::DrrMode::Blend}) {
+    step.setDrrMode(mode);
+    step.setDrrOpacity(1.0);
+    ASSERT_TRUE(view->isLayerVisible(fct::ReviewStepWidget::kDrrLayer));
+    EXPECT_GT(magentaPixels(), alone * 9 / 10) << "the outline stays on top of the DRR";
+  }
+}
+
+TEST(ReviewStepWidget, TheHistoryKeepsTheAcceptedResultAndGoesBackToAnyRun) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::ReviewStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  session.document.addResult(resultAt(session, session.T_truth));
+  step.acceptResult();
+  fct::RegistrationResult later = resultAt(session, session.T_truth);
+  later.cancelled = true;
+  EXPECT_FALSE(session.document.addResult(later)) << "a later run does not replace the accepted result";
+  QComboBox* history = step.historyChooser();
+  ASSERT_EQ(history->count(), 2);
+  EXPECT_EQ(history->currentIndex(), 0);
+  EXPECT_TRUE(history->itemText(0).contains(QStringLiteral("accepted"))) << history->itemText(0).toStdString();
+  EXPECT_TRUE(history->itemText(1).contains(QStringLiteral("cancelled"))) << history->itemText(1).toStdString();
+  emit history->activated(1);  // the user picks run 2 in the chooser
+  EXPECT_EQ(session.document.currentResultIndex(), 1);
+  EXPECT_TRUE(session.document.result()->cancelled);
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Undecided);
+  emit history->activated(0);  // and back to the accepted one
+  EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Accepted);
 }

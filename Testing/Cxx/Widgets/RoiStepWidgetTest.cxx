@@ -137,3 +137,21 @@ TEST(RoiStepWidget, CalibrationSpheresAreExcludedAndOutlined) {
   step.setActive(false);
   EXPECT_FALSE(session.xrayViews[0]->isLayerVisible(fct::RoiStepWidget::kSphereLayer)) << "hidden when inactive";
 }
+
+TEST(RoiStepWidget, SaysWhichMaskExcludedEachPatch) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RoiParameters parameters = session.document.roiParameters();
+  parameters.margin_px = 10;
+  session.document.setRoiParameters(parameters);
+  fct::RoiStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  const QString text = step.exclusionText();
+  const QString view = QString::fromStdString(session.document.views()[0].name);
+  EXPECT_TRUE(text.contains(view + QStringLiteral(" excluded:"))) << text.toStdString();
+  EXPECT_TRUE(text.contains(QStringLiteral("margin "))) << text.toStdString();
+  EXPECT_TRUE(text.contains(QStringLiteral("outside the field")));
+  EXPECT_TRUE(text.contains(QStringLiteral("spheres")));
+  // The 10-pixel margin of a 192 x 192 view is 19.3 % of it; the margin share says so (the field may take more).
+  EXPECT_FALSE(text.contains(QStringLiteral("margin 0.0 %"))) << text.toStdString();
+}

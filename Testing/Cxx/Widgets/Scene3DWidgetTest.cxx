@@ -2,6 +2,7 @@
 
 #include <QOpenGLContext>
 #include <QTest>
+#include <QVBoxLayout>
 
 #include "StudioTestCase.h"
 #include "Widgets/Scene3DWidget.h"
@@ -58,6 +59,48 @@ TEST(Scene3DWidgetRender, DrawsTheBoneInTheViewport) {
   const int bone = boneColouredPixels(image);
   EXPECT_GT(bone, 320 * 240 / 50) << "bone-coloured pixels: " << bone;
   EXPECT_LT(bone, 320 * 240);  // and the background is there too
+}
+
+// Render test: the view draws the bone again after it was shrunk to nothing (a collapsed splitter, a minimised window)
+// and given back its size, and after its top-level window changed (a new OpenGL context).
+TEST(Scene3DWidgetRender, DrawsTheBoneAgainAfterShrinkingToNothingAndRestoring) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  fct::StudioDocument document;
+  ASSERT_TRUE(document.loadCt(dir / "ct.nrrd").ok());
+  if (!fct::Scene3DWidget::openGlAvailable()) {
+    GTEST_SKIP() << "no OpenGL widgets on this Qt platform (the 'render' CTest runs this with xcb under xvfb-run)";
+  }
+  QWidget holder;
+  auto* layout = new QVBoxLayout(&holder);
+  layout->setContentsMargins(0, 0, 0, 0);
+  auto* scene = new fct::Scene3DWidget(&document, &holder);
+  layout->addWidget(scene);
+  holder.resize(320, 240);
+  holder.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&holder));
+  EXPECT_GT(boneColouredPixels(scene->grabFramebuffer()), 320 * 240 / 50);
+  for (const QSize size : {QSize(1, 1), QSize(0, 0)}) {
+    scene->setMinimumSize(0, 0);
+    holder.setMinimumSize(0, 0);
+    holder.resize(size);
+    scene->resize(size);
+    QTest::qWait(50);
+    (void)scene->grabFramebuffer();  // renders at the tiny size
+    holder.resize(320, 240);
+    QTest::qWait(50);
+    const int bone = boneColouredPixels(scene->grabFramebuffer());
+    EXPECT_GT(bone, 320 * 240 / 50) << "after shrinking to " << size.width() << "x" << size.height();
+  }
+  QWidget other;
+  other.resize(320, 240);
+  other.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&other));
+  scene->setParent(&other);  // another window: Qt gives the view a new OpenGL context
+  scene->resize(320, 240);
+  scene->show();
+  QTest::qWait(50);
+  EXPECT_GT(boneColouredPixels(scene->grabFramebuffer()), 320 * 240 / 50) << "in another window";
 }
 
 }  // namespace

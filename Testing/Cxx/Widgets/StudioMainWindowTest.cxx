@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <QAbstractButton>
+#include <QComboBox>
+#include <QTableWidget>
 #include <QApplication>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -15,6 +17,9 @@
 #include "StudioTestCase.h"
 #include "TestSupport.h"
 #include "Widgets/DataStepWidget.h"
+#include "Widgets/LandmarkStepWidget.h"
+#include "Widgets/RegisterStepWidget.h"
+#include "Widgets/ReviewStepWidget.h"
 #include "Widgets/SessionAutosave.h"
 #include "Widgets/SliceViewWidget.h"
 #include "Widgets/StudioDocument.h"
@@ -117,6 +122,117 @@ TEST_F(StudioMainWindowTest, LoadsTheCaseIntoTheViewsAndLinksTheCrosshair) {
   EXPECT_TRUE(window.isWindowModified());
 }
 
+TEST_F(StudioMainWindowTest, SliceTitleAndReadoutGiveTheSamePatientSideInLps) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  fct::SliceViewWidget* axial = window.sliceViews()[0];
+  fct::SliceViewWidget* sagittal = window.sliceViews()[2];
+  // Click on the patient's right (LPS x < 0) in the axial view: the sagittal slice moves there.
+  const Eigen::Vector3d right(-20.0, 5.0, axial->slicePosition_mm());
+  QTest::mouseClick(axial, Qt::LeftButton, Qt::NoModifier, axial->widgetPointForCtPoint(right));
+  const double x = sagittal->crosshair_ct_mm().x();
+  ASSERT_LT(x, -15.0);
+  const QString side = fct::SliceViewWidget::sideCoordinate(0, x);
+  EXPECT_TRUE(side.startsWith(QStringLiteral("R "))) << side.toStdString();
+  EXPECT_TRUE(sagittal->title().contains(side + QStringLiteral(" mm (LPS x -"))) << sagittal->title().toStdString();
+  // Hovering the sagittal view at the crosshair reads the same side and the same LPS x.
+  QTest::mouseMove(sagittal, sagittal->widgetPointForCtPoint(sagittal->crosshair_ct_mm()));
+  const QString readout = window.hoverText();
+  EXPECT_TRUE(readout.startsWith(QStringLiteral("Sagittal: LPS (") + QString::number(x, 'f', 1)))
+      << readout.toStdString();
+  EXPECT_TRUE(readout.contains(QStringLiteral("= ") + side)) << readout.toStdString();
+  EXPECT_EQ(fct::SliceViewWidget::sideCoordinate(1, -12.34), QStringLiteral("A 12.3"));
+  EXPECT_EQ(fct::SliceViewWidget::sideCoordinate(2, -0.01), QStringLiteral("S 0.0")) << "no signed zero";
+}
+
+TEST_F(StudioMainWindowTest, XraysOpenAtAReadableWindowAndTheUsersWindowIsSavedInTheSession) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  ASSERT_EQ(window.xrayViews().size(), 2u);
+  for (fct::XrayViewWidget* view : window.xrayViews()) {
+    // The built-in X-rays are 16-bit with a bright direct exposure; the window covers the patient only.
+    const auto& pixels = view->image().pixels;
+    const double range = fct::ImageViewWidget::quantile(pixels, 0.99) - fct::ImageViewWidget::quantile(pixels, 0.01);
+    EXPECT_LT(view->window(), 0.5 * range) << view->title().toStdString();
+    EXPECT_LT(view->level() + 0.5 * view->window(), fct::ImageViewWidget::quantile(pixels, 0.9));
+  }
+  EXPECT_TRUE(window.document()->xrayWindows().empty()) << "the automatic window is not a user setting";
+
+  // Ctrl-drag sets the window; it is saved and comes back with the session.
+  fct::XrayViewWidget* ap = window.xrayViews()[0];
+  QTest::mousePress(ap, Qt::LeftButton, Qt::ControlModifier, QPoint(100, 100));
+  QTest::mouseMove(ap, QPoint(160, 80));
+  QTest::mouseRelease(ap, Qt::LeftButton, Qt::ControlModifier, QPoint(160, 80));
+  const double userWindow = ap->window();
+  const double userLevel = ap->level();
+  ASSERT_EQ(window.document()->xrayWindows().count("ap"), 1u);
+  const QString path = QString::fromStdString((m_folder / "window.fctsession.json").string());
+  ASSERT_TRUE(window.saveSessionTo(path));
+  ASSERT_TRUE(window.newSession());
+  ASSERT_TRUE(window.openSession(path)) << window.lastMessage().toStdString();
+  ASSERT_EQ(window.xrayViews().size(), 2u);
+  EXPECT_DOUBLE_EQ(window.xrayViews()[0]->window(), userWindow);
+  EXPECT_DOUBLE_EQ(window.xrayViews()[0]->level(), userLevel);
+  EXPECT_FALSE(window.document()->isModified());
+}
+
+TEST_F(StudioMainWindowTest, ReopeningASessionRestoresResidualsProjectedLandmarksAndTheRegisterState) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  fct::StudioDocument& document = *window.document();
+  ASSERT_TRUE(document.truthPose());
+  // Five landmarks spread over the phantom, clicked at their true projections in both views.
+  fct::Landmarks landmarks;
+  const Eigen::Vector3d centre = document.ct()->centre_lps_mm();
+  const std::vector<Eigen::Vector3d> offsets{{-20, -10, -15}, {20, -10, -10}, {0, 15, 0}, {-10, 5, 20}, {15, 10, 15}};
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    const std::string name = "L" + std::to_string(i + 1);
+    landmarks.ct.push_back({name, centre + offsets[i]});
+    for (const fct::RegistrationView& view : document.views()) {
+      landmarks.imageByView[view.name].push_back({name, view.camera.project(*document.truthPose() * (centre + offsets[i]))});
+    }
+  }
+  document.setLandmarks(landmarks);
+  auto* landmarkStep = window.findChild<fct::LandmarkStepWidget*>();
+  auto* registerStep = window.findChild<fct::RegisterStepWidget*>();
+  ASSERT_TRUE(landmarkStep && registerStep);
+  ASSERT_TRUE(landmarkStep->computePose()) << landmarkStep->message().toStdString();
+  fct::RegistrationResult result;
+  result.T_initial = *document.initialPose();
+  result.T_world_from_ct = *document.truthPose();
+  result.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  result.totalDrrs = 321;
+  fct::StageReport stage;
+  stage.name = "vlnc-rois-1:1";
+  result.stages.push_back(stage);
+  document.addResult(result);
+  const QString path = QString::fromStdString((m_folder / "restored.fctsession.json").string());
+  ASSERT_TRUE(window.saveSessionTo(path));
+  ASSERT_TRUE(window.newSession());
+  EXPECT_EQ(registerStep->progressText(), QStringLiteral("Not started"));
+
+  ASSERT_TRUE(window.openSession(path)) << window.lastMessage().toStdString();
+  ASSERT_TRUE(landmarkStep->estimate().has_value()) << "the landmark estimate is made again";
+  EXPECT_TRUE(landmarkStep->table()->item(0, 3)->text().endsWith(QStringLiteral(" px")));
+  window.showStepNamed(QStringLiteral("initial-pose"));
+  for (fct::XrayViewWidget* view : window.xrayViews()) {
+    EXPECT_EQ(view->layerPoints(fct::LandmarkStepWidget::kProjectedLayer).size(), offsets.size());
+  }
+  EXPECT_EQ(registerStep->progressText(), QStringLiteral("Finished"));
+  EXPECT_TRUE(registerStep->logText().contains(QStringLiteral("Result 1 of 1"))) << registerStep->logText().toStdString();
+  EXPECT_TRUE(registerStep->logText().contains(QStringLiteral("Final (full resolution)")));
+  EXPECT_EQ(document.result()->totalDrrs, 321);
+}
+
 TEST_F(StudioMainWindowTest, AutosaveAppearsAfterAChangeAndIsRestoredAfterACrash) {
   const auto autosave = m_folder / "autosave.json";
   {
@@ -161,6 +277,7 @@ TEST_F(StudioMainWindowTest, CloseAsksAboutUnsavedChangesAndCancelKeepsEverythin
   answerNextMessageBox(QMessageBox::Cancel, &question);
   EXPECT_FALSE(window.close());
   EXPECT_TRUE(question.contains(QStringLiteral("unsaved changes"))) << question.toStdString();
+  EXPECT_TRUE(question.contains(QStringLiteral("It holds nothing yet"))) << "says what is unsaved: " << question.toStdString();
   EXPECT_TRUE(window.isVisible());
   EXPECT_EQ(window.document()->registrationOptions().seed, 5u);
   EXPECT_TRUE(std::filesystem::exists(m_folder / "autosave.json"));
@@ -196,6 +313,64 @@ TEST_F(StudioMainWindowTest, BadSessionShowsAMessageAndKeepsTheSession) {
   EXPECT_TRUE(window.lastMessage().contains(QStringLiteral("bad.fctsession.json")));
   EXPECT_EQ(window.document()->views().size(), 2u);
   EXPECT_EQ(window.document()->sessionPath(), m_folder / "good.fctsession.json");
+}
+
+TEST_F(StudioMainWindowTest, ACaseSwapAsksFirstThenDropsTheOldResultVerdictAndLandmarks) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  fct::StudioDocument& document = *window.document();
+  fct::Landmarks landmarks;
+  landmarks.ct = {{"L1", {1.0, 2.0, 3.0}}};
+  landmarks.imageByView["ap"] = {{"L1", {50.0, 60.0}}};
+  document.setLandmarks(landmarks);
+  fct::RegistrationResult result;
+  result.T_initial = *document.initialPose();
+  result.T_world_from_ct = result.T_initial;
+  document.addResult(result);
+  auto* review = window.findChild<fct::ReviewStepWidget*>();
+  ASSERT_NE(review, nullptr);
+  window.showStepNamed(QStringLiteral("review"));
+  review->acceptResult();
+  ASSERT_EQ(document.resultVerdict(), fct::ResultVerdict::Accepted);
+
+  // A second case (a copy of the built-in one): unsaved work is not dropped without asking; Cancel keeps it all.
+  const auto second = m_folder / "second_case";
+  std::filesystem::copy(fct::test::builtinCaseDir(), second, std::filesystem::copy_options::recursive);
+  QString question;
+  answerNextMessageBox(QMessageBox::Cancel, &question);
+  window.dataStep()->openCaseFolder(QString::fromStdString(second.string()));
+  EXPECT_TRUE(question.contains(QStringLiteral("registration results are dropped"))) << question.toStdString();
+  EXPECT_TRUE(question.contains(QStringLiteral("1 landmark"))) << question.toStdString();
+  EXPECT_TRUE(question.contains(QStringLiteral("1 accepted"))) << question.toStdString();
+  EXPECT_FALSE(window.dataStep()->isBusy()) << "cancelled: nothing loads";
+  EXPECT_EQ(document.resultVerdict(), fct::ResultVerdict::Accepted);
+
+  // Discard: the new case comes in and nothing derived from the old one survives.
+  QSignalSpy finished(window.dataStep(), &fct::DataStepWidget::loadFinished);
+  answerNextMessageBox(QMessageBox::Discard);
+  window.dataStep()->openCaseFolder(QString::fromStdString(second.string()));
+  ASSERT_TRUE(finished.wait(20000));
+  ASSERT_TRUE(finished.at(0).at(0).toBool()) << finished.at(0).at(1).toString().toStdString();
+  EXPECT_EQ(document.result(), nullptr);
+  EXPECT_TRUE(document.results().empty());
+  EXPECT_EQ(document.resultVerdict(), fct::ResultVerdict::Undecided);
+  EXPECT_TRUE(document.landmarks().ct.empty());
+  EXPECT_TRUE(document.landmarks().imageByView.empty());
+  ASSERT_TRUE(document.initialPose()) << "the new case's own initial pose";
+  EXPECT_TRUE(document.initialPoseSource().contains(QStringLiteral("initial_pose.json")));
+  EXPECT_TRUE(document.sessionPath().empty()) << "saving must not overwrite the first case's session";
+  EXPECT_EQ(review->historyChooser()->count(), 0);
+
+  // A saved session holds its work: then the swap needs no question.
+  ASSERT_TRUE(window.saveSessionTo(QString::fromStdString((m_folder / "second.fctsession.json").string())));
+  document.addResult(result);
+  ASSERT_TRUE(window.saveSessionTo(QString::fromStdString((m_folder / "second.fctsession.json").string())));
+  finished.clear();
+  window.dataStep()->openCaseFolder(QString::fromStdString(fct::test::builtinCaseDir().string()));
+  ASSERT_TRUE(finished.wait(20000));
+  EXPECT_TRUE(document.results().empty());
 }
 
 }  // namespace

@@ -57,8 +57,14 @@ void fillDocument(StudioDocument& d) {
   stage.keptFraction = {0.1, 0.2};
   result.stages.push_back(stage);
   result.schedule = fct::RegistrationSchedule::builtin("fast").value();
-  d.setResult(result);
+  d.addResult(result);
   d.setResultVerdict(fct::ResultVerdict::Rejected);
+  result.cancelled = false;
+  result.totalDrrs = 99;
+  d.addResult(result);
+  d.setResultVerdict(fct::ResultVerdict::Accepted);
+  d.setCurrentResult(0);
+  d.setXrayWindow("ap", {1200.0, 30000.0});
 }
 
 void expectSameDocument(const StudioDocument& a, const StudioDocument& b) {
@@ -91,6 +97,11 @@ void expectSameDocument(const StudioDocument& a, const StudioDocument& b) {
   EXPECT_EQ(b.result()->stages[0].keptFraction, (std::vector<double>{0.1, 0.2}));
   EXPECT_EQ(b.result()->schedule.stages.size(), a.result()->schedule.stages.size());
   EXPECT_EQ(b.resultVerdict(), fct::ResultVerdict::Rejected);
+  ASSERT_EQ(b.results().size(), 2u) << "the whole history";
+  EXPECT_EQ(b.currentResultIndex(), 0);
+  EXPECT_EQ(b.results()[1].verdict, fct::ResultVerdict::Accepted);
+  EXPECT_EQ(b.results()[1].result.totalDrrs, 99);
+  EXPECT_EQ(b.xrayWindows(), a.xrayWindows());
   ASSERT_TRUE(b.truthPose());
   EXPECT_TRUE(a.truthPose()->isApprox(*b.truthPose(), 1e-12));
 }
@@ -113,7 +124,7 @@ TEST(StudioSession, SaveThenOpenGivesTheSameDocument) {
   EXPECT_EQ(reopened.sessionPath(), path);
 }
 
-TEST(StudioSession, SavesTheResultAsTheObjectOfResultFiles) {
+TEST(StudioSession, SavesEachResultAsTheObjectOfResultFiles) {
   ASSERT_FALSE(fct::test::builtinCaseDir().empty());
   StudioDocument document;
   fillDocument(document);
@@ -121,8 +132,11 @@ TEST(StudioSession, SavesTheResultAsTheObjectOfResultFiles) {
   ASSERT_TRUE(StudioSession::save(document, path).ok());
   auto json = fct::JsonDocument::parse(path);
   ASSERT_TRUE(json.ok()) << json.error();
-  EXPECT_EQ(json.value()["version"], 2);
-  const nlohmann::json& result = json.value()["result"];
+  EXPECT_EQ(json.value()["version"], 3);
+  EXPECT_EQ(json.value()["current_result"], 0);
+  ASSERT_EQ(json.value()["results"].size(), 2u);
+  EXPECT_EQ(json.value()["results"][1]["verdict"], "accepted");
+  const nlohmann::json& result = json.value()["results"][0];
   EXPECT_EQ(result["format"], fct::RegistrationResultJson::kFormat);
   EXPECT_EQ(result["verdict"], "rejected");
   auto read = fct::RegistrationResultJson::read(result, "session: result");
@@ -155,7 +169,7 @@ TEST(StudioSession, BadSessionFileLeavesTheDocumentAsItWas) {
 TEST(StudioSession, BadValueMessagesNameTheSectionAndEntry) {
   // Each file is valid JSON of the session format with one bad section; the message names where to fix it.
   const std::vector<std::pair<std::string, std::string>> cases{
-      {R"("version": 3)", "version"},
+      {R"("version": 4)", "version"},
       {R"("views": {"files": []})", "views needs \"view_file\" or \"xray_files\""},
       {R"("views": {"xray_files": [{"name": "ap"}]})", "views.xray_files[0]"},
       {R"("landmarks": {"ct": [{"name": "L1", "p_ct_mm": [1, 2, 3]}, {"name": "L2"}]})", "landmarks.ct[1]"},
@@ -167,6 +181,10 @@ TEST(StudioSession, BadValueMessagesNameTheSectionAndEntry) {
        "target_fraction"},
       {R"("registration": {"preset": "fast", "seed": -1, "drr_method": "siddon"})", "registration"},
       {R"("result": {"verdict": "maybe"})", "use accepted, rejected or undecided"},
+      {R"("results": {"verdict": "accepted"})", "results must be an array"},
+      {R"("results": [{"verdict": "maybe"}])", "results[0]"},
+      {R"("current_result": 0)", "current_result must be an index into results"},
+      {R"("display": {"xray_windows": {"ap": {"window": -1, "level": 0}}})", "display.xray_windows.ap"},
       {R"("truth_pose": {"T_world_from_ct": [[1, 0], [0, 1]]})", "truth_pose"},
   };
   const auto path = fct::test::scratchDir() / "bad.fctsession.json";
@@ -196,6 +214,29 @@ TEST(StudioSession, AutosaveReopensModifiedAndRemembersItsSessionFile) {
   EXPECT_TRUE(restored.isModified());
   EXPECT_EQ(restored.sessionPath(), folder / "mine.fctsession.json");
   EXPECT_EQ(restored.registrationOptions().seed, 7u);
+}
+
+TEST(StudioSession, OpensASessionFileOfVersion2AsAHistoryOfOneResult) {
+  ASSERT_FALSE(fct::test::builtinCaseDir().empty());
+  StudioDocument document;
+  fillDocument(document);
+  const auto path = fct::test::scratchDir() / "v2.fctsession.json";
+  ASSERT_TRUE(StudioSession::save(document, path).ok());
+  // Version 2 wrote the one result the Studio kept as "result", without a history or windows.
+  auto json = fct::JsonDocument::parse(path).value();
+  json["version"] = 2;
+  json["result"] = json["results"][1];
+  for (const char* key : {"results", "current_result", "display"}) json.erase(key);
+  ASSERT_TRUE(fct::JsonDocument::write(json, path).ok());
+
+  StudioDocument reopened;
+  const fct::Status opened = StudioSession::open(reopened, path);
+  ASSERT_TRUE(opened.ok()) << opened.error();
+  ASSERT_EQ(reopened.results().size(), 1u);
+  EXPECT_EQ(reopened.currentResultIndex(), 0);
+  EXPECT_EQ(reopened.result()->totalDrrs, 99);
+  EXPECT_EQ(reopened.resultVerdict(), fct::ResultVerdict::Accepted);
+  EXPECT_TRUE(reopened.xrayWindows().empty());
 }
 
 TEST(StudioSession, OpensASessionFileOfVersion1) {

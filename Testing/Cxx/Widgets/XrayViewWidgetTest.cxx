@@ -155,4 +155,55 @@ TEST(XrayViewWidget, ShowsAnXrayImageWithARobustWindow) {
   EXPECT_FALSE(view.hasImage());
 }
 
+/// A 200 x 100 X-ray like the built-in case's: the direct exposure (60000) on the left 40 %, the patient on the right,
+/// its soft tissue ramping from 12000 down to 3000 away from the skin edge, with a bone block at 2000.
+fct::XrayImage patientXray() {
+  fct::XrayImage xray;
+  xray.cols = 200;
+  xray.rows = 100;
+  xray.pixels.resize(200 * 100);
+  for (int row = 0; row < xray.rows; ++row) {
+    for (int col = 0; col < xray.cols; ++col) {
+      float value = 60000.0f;
+      if (col >= 80) value = std::max(3000.0f, 12000.0f - 600.0f * static_cast<float>(col - 80));
+      if (col >= 120 && col < 160 && row >= 30 && row < 70) value = 2000.0f;
+      xray.pixels[static_cast<std::size_t>(row * xray.cols + col)] = value;
+    }
+  }
+  return xray;
+}
+
+TEST(XrayViewWidget, OpensAtAWindowOnThePatientNotTheDirectExposure) {
+  XrayViewWidget view;
+  view.resize(400, 300);
+  view.setImage(patientXray());
+  const double low = view.level() - 0.5 * view.window();
+  const double high = view.level() + 0.5 * view.window();
+  EXPECT_LE(low, 2000.0 + 1.0) << "the bone is at the dark end";
+  EXPECT_GE(high, 3000.0) << "the soft tissue next to the bone is brighter than the bone";
+  EXPECT_LT(high, 15000.0) << "the direct exposure (60000) takes no grey levels";
+  view.applyWindowPreset(fct::XrayWindowPreset::FullRange);
+  EXPECT_DOUBLE_EQ(view.window(), 58000.0);
+  view.applyWindowPreset(fct::XrayWindowPreset::WholeField);
+  EXPECT_GT(view.level() + 0.5 * view.window(), 59000.0) << "the whole field reaches the direct exposure";
+  view.applyWindowPreset(fct::XrayWindowPreset::Automatic);
+  EXPECT_NEAR(view.level() + 0.5 * view.window(), high, 1e-9);
+  EXPECT_EQ(view.fieldMask().size(), 200u * 100u);
+}
+
+TEST(XrayViewWidget, AnImageWithoutDirectExposureOpensAtItsRobustRange) {
+  XrayViewWidget view;
+  fct::XrayImage xray;
+  xray.cols = 100;
+  xray.rows = 10;
+  for (int i = 0; i < 1000; ++i) xray.pixels.push_back(100.0f + static_cast<float>(i % 100));
+  view.setImage(xray);
+  EXPECT_NEAR(view.level(), 149.5, 1.0);
+  EXPECT_NEAR(view.window(), 98.0, 1.0);
+  fct::XrayImage empty;
+  view.setImage(empty);
+  view.applyWindowPreset(fct::XrayWindowPreset::Automatic);  // nothing shown: no effect, no crash
+  EXPECT_FALSE(view.hasImage());
+}
+
 }  // namespace
