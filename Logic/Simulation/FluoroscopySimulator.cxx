@@ -12,6 +12,7 @@
 #include "Base/SeededRandom.h"
 #include "Simulation/ForeignObjectSet.h"
 #include "Simulation/IntensifierDistortion.h"
+#include "Simulation/Physics/CubicBsplinePatient.h"
 #include "Simulation/Physics/MaterialPathTracer.h"
 #include "Simulation/Physics/XraySpectrum.h"
 
@@ -19,12 +20,20 @@ namespace fct {
 
 namespace {
 
-/// What every view of a case shares: the spectrum with its attenuation table, the CT tracer and the implants.
+/// What every view of a case shares: the spectrum with its attenuation table, the patient (one of the two models)
+/// and the implants.
 struct Scene {
   XraySpectrum spectrum;
   std::vector<MassPaths> massAttenuation_cm2_per_g;  ///< per bin, per material
-  MaterialPathTracer tracer;
+  std::optional<CubicBsplinePatient> continuousPatient;
+  std::optional<MaterialPathTracer> voxelPatient;
   ForeignObjectSet implants;  ///< CT frame
+
+  /// The patient's mass paths along a ray (CT frame).
+  MassPaths trace(const Eigen::Vector3d& origin_ct_mm, const Eigen::Vector3d& direction_ct) const {
+    return continuousPatient ? continuousPatient->trace(origin_ct_mm, direction_ct)
+                             : voxelPatient->trace(origin_ct_mm, direction_ct);
+  }
 };
 
 /// One rendered view.
@@ -49,6 +58,15 @@ Status validate(const FluoroscopyOptions& o) {
                             o.photonsPerPixel));
   }
   if (bad(o.psfSigma_px, 0.0, 20.0)) return fail(fmt::format("PSF sigma must be 0..20 px, got {}", o.psfSigma_px));
+  if (bad(o.scatterToPrimary, 0.0, 5.0)) {
+    return fail(fmt::format("scatter-to-primary ratio must be 0..5, got {}", o.scatterToPrimary));
+  }
+  if (bad(o.scatterSigma_mm, 1.0, 500.0)) {
+    return fail(fmt::format("scatter haze sigma must be 1..500 mm, got {}", o.scatterSigma_mm));
+  }
+  if (o.patient == PatientModel::VoxelBoxes && o.patientExtension_mm != 0.0) {
+    return fail("a patient extension beyond the CT needs the continuous (cubic B-spline) patient model");
+  }
   if (!(o.gain > 0.0 && std::isfinite(o.gain))) return fail(fmt::format("gain must be positive, got {}", o.gain));
   if (!std::isfinite(o.offset)) return fail(fmt::format("offset must be finite, got {}", o.offset));
   if (bad(o.gamma, 0.1, 10.0)) return fail(fmt::format("gamma must be 0.1..10, got {}", o.gamma));
@@ -76,13 +94,20 @@ Result<Scene> prepareScene(const Volume& ct, const FluoroscopyOptions& options) 
   if (Status valid = validate(options); !valid) return fail(valid.error());
   auto spectrum = XraySpectrum::create(spectrumOptions(options));
   if (!spectrum.ok()) return fail(spectrum.error());
-  auto tracer = MaterialPathTracer::create(ct, options.materials);
-  if (!tracer.ok()) return fail(tracer.error());
   auto implants = ForeignObjectSet::placeNearBone(
       ct, {options.kwireCount, options.screwCount, options.plate, options.gasPocketCount, options.boneThreshold_hu,
            options.seed});
   if (!implants.ok()) return fail(implants.error());
-  Scene scene{std::move(spectrum).value(), {}, std::move(tracer).value(), std::move(implants).value()};
+  Scene scene{std::move(spectrum).value(), {}, std::nullopt, std::nullopt, std::move(implants).value()};
+  if (options.patient == PatientModel::CubicBspline) {
+    auto patient = CubicBsplinePatient::create(ct, options.materials, options.patientExtension_mm);
+    if (!patient.ok()) return fail(patient.error());
+    scene.continuousPatient = std::move(patient).value();
+  } else {
+    auto tracer = MaterialPathTracer::create(ct, options.materials);
+    if (!tracer.ok()) return fail(tracer.error());
+    scene.voxelPatient = std::move(tracer).value();
+  }
   for (const SpectrumBin& bin : scene.spectrum.bins()) {
     MassPaths mu{};
     for (int m = 0; m < kMaterialCount; ++m) {
@@ -168,18 +193,20 @@ Result<ForeignObjectSet> calibrationSpheresFor(const Camera& camera, const Fluor
                                            options.sphereDistanceFromDetector_mm);
 }
 
-/// Per pixel (row-major): the mass paths of its ray, and whether the collimator lets it through.
+/// Per pixel (row-major): the mass paths of its ray, whether the collimator lets it through, and its noiseless
+/// scatter signal (empty without a scatter haze).
 struct LineIntegrals {
   std::vector<MassPaths> pixelPaths;
   std::vector<std::uint8_t> exposed;
+  std::vector<float> scatter;
 };
 
-/// Pass 1: exact material path integrals through the CT, the implants and the spheres for every pixel inside the
+/// Pass 1: material path integrals through the patient, the implants and the spheres for every pixel inside the
 /// collimator, with their noiseless signal written to `image` (pixels outside stay 0).
 LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, const ForeignObjectSet& spheres,
                                  const SpectrumWeights& weights, FloatImage& image) {
   const std::size_t pixelCount = static_cast<std::size_t>(g.in.cols) * g.in.rows;
-  LineIntegrals rays{std::vector<MassPaths>(pixelCount), std::vector<std::uint8_t>(pixelCount, 0)};
+  LineIntegrals rays{std::vector<MassPaths>(pixelCount), std::vector<std::uint8_t>(pixelCount, 0), {}};
   tbb::parallel_for(0, g.in.rows, [&](int row) {
     std::vector<double> transmission(weights.energyWeight.size());
     for (int col = 0; col < g.in.cols; ++col) {
@@ -189,7 +216,7 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
           Eigen::Vector3d((col - g.K(0, 2)) / g.K(0, 0), (row - g.K(1, 2)) / g.K(1, 1), 1.0).normalized();
       const Eigen::Vector3d direction_ct = g.R_ct_from_camera * direction_camera;
       MassPaths& paths = rays.pixelPaths[index];
-      paths = scene.tracer.trace(g.source_ct, direction_ct);
+      paths = scene.trace(g.source_ct, direction_ct);
       scene.implants.accumulate(g.source_ct, direction_ct, paths);
       spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
       for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
@@ -198,6 +225,29 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
     }
   });
   return rays;
+}
+
+/// The scatter haze: scatterToPrimary times the noiseless primary signal of `image` blurred by a Gaussian of
+/// scatterSigma_mm on the detector (pixels outside the collimator add nothing and get nothing), kept in
+/// rays.scatter and added to `image`. Nothing without a haze; fails on an OpenCV error.
+Status addScatterHaze(const FluoroscopyOptions& options, const CameraIntrinsics& in, LineIntegrals& rays,
+                      FloatImage& image) {
+  if (options.scatterToPrimary <= 0.0) return Ok{};
+  const double sigma_px = options.scatterSigma_mm / in.pixelSpacing_mm.mean();
+  try {
+    cv::Mat primary(image.rows, image.cols, CV_32F, image.pixels.data());
+    cv::Mat haze;
+    cv::GaussianBlur(primary, haze, cv::Size(0, 0), sigma_px, sigma_px, cv::BORDER_REFLECT);
+    rays.scatter.assign(image.pixels.size(), 0.0f);
+    for (std::size_t index = 0; index < image.pixels.size(); ++index) {
+      if (!rays.exposed[index]) continue;
+      rays.scatter[index] = static_cast<float>(options.scatterToPrimary * haze.at<float>(static_cast<int>(index)));
+      image.pixels[index] += rays.scatter[index];
+    }
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("scatter haze failed: {}", e.what()));
+  }
+  return Ok{};
 }
 
 /// Sets the view's maxLineIntegral and referenceSignal (automatic exposure: the 99th percentile of the exposed
@@ -221,7 +271,7 @@ Status measureExposure(const std::vector<std::uint8_t>& exposed, const Fluorosco
 }
 
 /// Pass 2: exposure scaling of every exposed pixel by the reference signal and, with a dose, Poisson quantum noise per
-/// energy bin (one random stream per row, from viewSeed).
+/// energy bin, and for the scatter haze at the spectrum's mean energy (one random stream per row, from viewSeed).
 void exposeWithQuantumNoise(const Scene& scene, const SpectrumWeights& weights, const LineIntegrals& rays,
                             const FluoroscopyOptions& options, std::uint32_t viewSeed, double referenceSignal,
                             FloatImage& image) {
@@ -242,6 +292,9 @@ void exposeWithQuantumNoise(const Scene& scene, const SpectrumWeights& weights, 
       for (std::size_t b = 0; b < transmission.size(); ++b) {
         energy += static_cast<double>(random.poisson(photons * weights.photonFraction[b] * transmission[b])) *
                   scene.spectrum.bins()[b].energy_keV;
+      }
+      if (!rays.scatter.empty()) {
+        energy += static_cast<double>(random.poisson(photons * rays.scatter[index])) * weights.energyNorm;
       }
       out = static_cast<float>(energy / (options.photonsPerPixel * weights.energyNorm));
     }
@@ -319,7 +372,8 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
 
   RenderedView view;
   view.image = FloatImage::filled(geometry.in.cols, geometry.in.rows);
-  const LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, view.image);
+  LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, view.image);
+  if (Status haze = addScatterHaze(options, geometry.in, rays, view.image); !haze) return fail(haze.error());
   if (Status exposure = measureExposure(rays.exposed, options, view); !exposure) return fail(exposure.error());
   exposeWithQuantumNoise(scene, weights, rays, options, viewSeed, view.referenceSignal, view.image);
   if (Status blurred = blurPointSpread(options.psfSigma_px, view.image); !blurred) return fail(blurred.error());
@@ -342,9 +396,13 @@ nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
   j["hu_bone_from"] = o.materials.boneFrom_hu;
   j["hu_cortical_bone"] = o.materials.corticalBone_hu;
   j["hu_metal_from"] = o.materials.metalFrom_hu;
+  j["patient_model"] = o.patient == PatientModel::CubicBspline ? "cubic_bspline" : "voxel_boxes";
+  j["patient_extension_mm"] = o.patientExtension_mm;
   j["automatic_exposure"] = o.automaticExposure;
   j["photons_per_pixel"] = o.photonsPerPixel;
   j["psf_sigma_px"] = o.psfSigma_px;
+  j["scatter_to_primary"] = o.scatterToPrimary;
+  j["scatter_sigma_mm"] = o.scatterSigma_mm;
   j["gain"] = o.gain;
   j["offset"] = o.offset;
   j["gamma"] = o.gamma;
