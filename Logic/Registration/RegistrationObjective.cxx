@@ -117,7 +117,7 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
       cutFaces = std::move(mask).value();
     }
     // The pixels the comparison may use: valid, and clear of the cut faces when those are left out.
-    const std::size_t validCount =
+    std::size_t validCount =
         cutFaces ? keepValid(pyramidLevel.mask.pixelList(), *cutFaces).size() : pyramidLevel.mask.validCount();
 
     // The pixel set: windows for VLNC and for ROIs, the valid pixels otherwise.
@@ -132,15 +132,28 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
       if (!selected) return fail(fmt::format("stage '{}': {}", stage.name, selected.error()));
       selection = std::move(selected).value();
       if (cutFaces) {
-        selection = keepValidWindows(selection, *cutFaces);
-        if (rois) {
-          selection = strongestWindows(selection, stage.pixels.targetFraction, validCount);
+        RoiSelection clear = keepValidWindows(selection, *cutFaces);
+        if (clear.windows.empty()) {  // no window clear of the cut faces at this level: keep the unmasked ROIs
+          auto unmasked = rois ? registrationCase.rois(v, level, stage.pixels.windowSize, stage.pixels.targetFraction)
+                               : Result<RoiSelection>(selection);
+          if (!unmasked) return fail(fmt::format("stage '{}': {}", stage.name, unmasked.error()));
+          selection = std::move(unmasked).value();
+          validCount = pyramidLevel.mask.validCount();
+        } else {
+          selection = rois ? strongestWindows(clear, stage.pixels.targetFraction, validCount) : std::move(clear);
         }
       }
       view.pixels = selection.pixels;
     } else {
       view.pixels = pyramidLevel.mask.pixelList();
-      if (cutFaces) view.pixels = keepValid(view.pixels, *cutFaces);
+      if (cutFaces) {
+        PixelIndexList clear = keepValid(view.pixels, *cutFaces);
+        if (!clear.empty()) {
+          view.pixels = std::move(clear);
+        } else {  // every valid ray crosses them: keep all
+          validCount = pyramidLevel.mask.validCount();
+        }
+      }
       if (stage.pixels.maxPixels > 0) view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stage.pixels.maxPixels);
     }
     if (view.pixels.empty()) {

@@ -32,7 +32,8 @@ class RegistrationObjective {
   /// renderers integrate the full CT, or, given T_coarseCt_world_from_ct, the CT coarsened to the stage level's pixel
   /// footprint at that pose (RegistrationCase::levelRenderer; the CT pyramid). Given T_cutFaces_world_from_ct, the
   /// pixels (VLNC: the windows with a pixel) whose rays at that pose cross the CT's cut faces are left out
-  /// (RegistrationCase::cutFaceMask); fails, naming the view, when that leaves none.
+  /// (RegistrationCase::cutFaceMask), unless that leaves a view no pixel (no complete window for VLNC): then that view
+  /// keeps its unmasked set in that stage.
   static Result<RegistrationObjective> create(
       RegistrationCase& registrationCase, const RegistrationStage& stage, bool useViewRenderers = true,
       const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct = std::nullopt,
