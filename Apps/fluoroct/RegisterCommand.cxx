@@ -53,6 +53,7 @@ struct Options {
   bool noFieldOfView = false;
   bool noMetalMask = false;
   double metalMinExcess = MetalMaskOptions{}.minExcess;
+  double cutFaceMargin_mm = RegistrationCaseOptions{}.cutFaceMargin_mm;
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
   std::string dicomReg;  ///< optional DICOM Spatial Registration object (REG) of the final pose
   RegistrationAblation ablation;
@@ -212,6 +213,7 @@ RegistrationCaseOptions caseOptionsFor(const Options& o, const Inputs& in) {
   options.preparation.detectFieldOfView = !o.noFieldOfView;
   options.preparation.excludeMetal = !o.noMetalMask;
   options.preparation.metal.minExcess = o.metalMinExcess;
+  options.cutFaceMargin_mm = o.cutFaceMargin_mm;
   return options;
 }
 
@@ -339,7 +341,8 @@ nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r,
                                  {"ablation", o.ablation.activeNames()},
                                  {"field_of_view_detection", !o.noFieldOfView},
                                  {"metal_mask", !o.noMetalMask},
-                                 {"metal_min_excess", o.metalMinExcess}};
+                                 {"metal_min_excess", o.metalMinExcess},
+                                 {"cut_face_margin_mm", o.cutFaceMargin_mm}};
   for (const auto& item : json["options"].items()) options[item.key()] = item.value();
   json["options"] = std::move(options);
   json["transgraph"] = std::move(transgraph);
@@ -544,6 +547,11 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--metal-min-excess", options->metalMinExcess,
                       "Line integral a narrow shadow must add over its surroundings to count as metal (-ln of the "
                       "fraction of signal it passes; physical, log-linear detector images)")
+      ->capture_default_str();
+  command->add_option("--cut-face-margin-mm", options->cutFaceMargin_mm,
+                      "Leave out the pixels whose rays, at the initial pose, cross the patient beyond the CT's first "
+                      "or last slice or pass within this many mm of those cut faces (the X-ray shows anatomy there "
+                      "that the CT lacks); negative = off")
       ->capture_default_str();
   command->add_option("--masks", options->masks,
                       "Folder for one PNG per view (<view>_mask.png): white pixels are compared with the DRR, black "

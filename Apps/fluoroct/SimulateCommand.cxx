@@ -200,7 +200,7 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
         }
         document["registration_ct"] = {{"file", "ct_registration.nrrd"},
                                        {"slice_spacing_mm", options->ctSlice_mm},
-                                       {"slice_profile", "box of width slice_spacing_mm"}};
+                                       {"slice_profile", "box of width slice_spacing_mm over the original slab (spacing rounded to fill it exactly)"}};
         if (Status written = JsonDocument::write(document, simulated.value().parameterFile); !written) {
           return reportError(written.error());
         }

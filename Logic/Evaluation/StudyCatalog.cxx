@@ -125,6 +125,10 @@ double StudyCatalog::scenarioSliceSpacing_mm(std::string_view scenario) {
   return 0.0;
 }
 
+bool StudyCatalog::scenarioHasForeignObjects(std::string_view scenario) {
+  return scenario == "realistic" || scenario == "bad";
+}
+
 Result<StudyDefinition> StudyCatalog::define(std::string_view name, bool quick, const std::vector<std::string>& ctLabels,
                                              DrrMethod method) {
   if (ctLabels.empty()) return fail(fmt::format("study '{}' needs at least one CT", name));

@@ -31,6 +31,9 @@ class StudyCatalog {
                                         DrrMethod method = DrrMethod::Siddon);
   /// Slice spacing (mm) of the registration CT in a scenario: ideal 0 (the original CT), realistic 2.4, bad 4.2.
   static double scenarioSliceSpacing_mm(std::string_view scenario);
+  /// Whether a scenario's X-rays show foreign objects that are not in the CT (K-wires, screws): realistic and bad,
+  /// as the paper's "some objects"; ideal has none.
+  static bool scenarioHasForeignObjects(std::string_view scenario);
 };
 
 }  // namespace fct

@@ -18,6 +18,7 @@
 #include "Drr/DrrRendererFactory.h"
 #include "Evaluation/PoseErrorMetrics.h"
 #include "Evaluation/PoseOffset.h"
+#include "Evaluation/StudyCatalog.h"
 #include "Evaluation/StudyXraySource.h"
 #include "Geometry/RigidPose.h"
 #include "Registration/Registration.h"
@@ -30,12 +31,14 @@ namespace {
 
 constexpr int kMaxViews = 5;
 
-/// Everything about one CT that its trials share: error measures, truth and the simulated X-rays (all views).
+/// Everything about one CT that its trials share: error measures, truth and the simulated X-rays (all views), without
+/// and (when a scenario needs them) with foreign objects.
 struct CtScene {
   const Volume* ct = nullptr;
   std::unique_ptr<PoseErrorMetrics> metrics;
   Eigen::Isometry3d T_truth = Eigen::Isometry3d::Identity();
   std::vector<RegistrationView> xrays;
+  std::vector<RegistrationView> xraysWithObjects;
 };
 
 /// One trial to run.
@@ -69,7 +72,8 @@ struct TrialWork {
 
 /// Conditions registering on the same CT (after resampling, if any) with the same views share a case.
 std::string caseKey(const StudyCondition& c, const Volume& ct) {
-  return fmt::format("{}|{}|{}", c.ct, StudyXraySource::effectiveSliceSpacing_mm(ct, c.sliceSpacing_mm), c.viewCount);
+  return fmt::format("{}|{}|{}|{}", c.ct, StudyXraySource::effectiveSliceSpacing_mm(ct, c.sliceSpacing_mm),
+                     c.viewCount, StudyCatalog::scenarioHasForeignObjects(c.scenario));
 }
 
 /// Checks the job count and every condition (unique name, known CT, views, trials, initial range) before any work.
@@ -187,9 +191,9 @@ int viewsNeeded(const std::vector<PendingTrial>& pending, const std::string& lab
   return viewCount;
 }
 
-/// The scene of one CT: its error measures, true pose and `viewCount` standard views simulated at that pose. Fails on
-/// a CT without bone, bad view settings or a simulation error.
-Result<CtScene> simulateScene(const StudyCt& ct, int viewCount, const StudySetup& setup,
+/// The scene of one CT: its error measures, true pose and `viewCount` standard views simulated at that pose (also with
+/// foreign objects when `withObjects`). Fails on a CT without bone, bad view settings or a simulation error.
+Result<CtScene> simulateScene(const StudyCt& ct, int viewCount, bool withObjects, const StudySetup& setup,
                               const StudyRunOptions& options) {
   CtScene scene;
   scene.ct = &ct.volume;
@@ -202,9 +206,15 @@ Result<CtScene> simulateScene(const StudyCt& ct, int viewCount, const StudySetup
   auto views = StandardViews::build(Eigen::Vector3d::Zero(), viewOptions);
   if (!views) return fail(views.error());
   say(options, fmt::format("simulating {} X-ray views of CT '{}'", viewCount, ct.label));
-  auto xrays = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, setup.seed);
+  auto xrays = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, setup.seed, false);
   if (!xrays) return fail(fmt::format("CT '{}': {}", ct.label, xrays.error()));
   scene.xrays = std::move(xrays).value();
+  if (withObjects) {
+    say(options, fmt::format("simulating {} X-ray views of CT '{}' with foreign objects", viewCount, ct.label));
+    auto withTools = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, setup.seed, true);
+    if (!withTools) return fail(fmt::format("CT '{}': {}", ct.label, withTools.error()));
+    scene.xraysWithObjects = std::move(withTools).value();
+  }
   return scene;
 }
 
@@ -215,7 +225,10 @@ Result<CtScenes> simulateScenes(const StudyDefinition& study, const std::vector<
   for (const StudyCt& ct : cts) {
     const int viewCount = viewsNeeded(pending, ct.label);
     if (viewCount == 0) continue;
-    auto scene = simulateScene(ct, viewCount, study.setup, options);
+    const bool withObjects = std::any_of(pending.begin(), pending.end(), [&](const PendingTrial& p) {
+      return p.condition->ct == ct.label && StudyCatalog::scenarioHasForeignObjects(p.condition->scenario);
+    });
+    auto scene = simulateScene(ct, viewCount, withObjects, study.setup, options);
     if (!scene) return fail(scene.error());
     scenes.emplace(ct.label, std::move(scene).value());
   }
@@ -227,6 +240,7 @@ RegistrationCaseOptions caseOptionsFor(const StudySetup& setup) {
   RegistrationCaseOptions caseOptions;
   caseOptions.drr.method = setup.method;
   caseOptions.drr.transgraph.spacing_mm = setup.transgraphSpacing_mm;
+  caseOptions.cutFaceMargin_mm = 5.0;  // the simulated patient continues beyond the CT's end faces
   caseOptions.drr.transgraphCacheFolder = setup.transgraphCacheDir.empty()
                                               ? std::nullopt
                                               : std::optional<std::filesystem::path>(setup.transgraphCacheDir);
@@ -251,7 +265,9 @@ Result<CasePrototypes> prepareCases(const StudyDefinition& study, const std::vec
                              c.viewCount));
     auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
     if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
-    const std::vector<RegistrationView> views(scene.xrays.begin(), scene.xrays.begin() + c.viewCount);
+    const std::vector<RegistrationView>& xrays =
+        StudyCatalog::scenarioHasForeignObjects(c.scenario) ? scene.xraysWithObjects : scene.xrays;
+    const std::vector<RegistrationView> views(xrays.begin(), xrays.begin() + c.viewCount);
     auto created = RegistrationCase::create(registrationCt.value(), views, caseOptions);
     if (!created) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, created.error()));
     prototypes.emplace(key, std::make_unique<RegistrationCase>(std::move(created).value()));

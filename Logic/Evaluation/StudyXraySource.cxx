@@ -11,32 +11,44 @@ namespace fct {
 
 namespace {
 
-/// The simulated C-arm: 80 kVp polyenergetic beam, quantum noise, detector blur and vignetting; no distortion,
-/// collimator or foreign objects (those are studied separately).
-FluoroscopyOptions studyOptions() {
+/// The simulated C-arm and patient: the CT's continuous interpolant continued 60 mm beyond its end faces, 80 kVp
+/// polyenergetic beam, a scatter haze (scatter-to-primary 0.1, sigma 40 mm: a C-arm with an anti-scatter grid), quantum noise, detector blur and
+/// vignetting; with foreign objects, 2 K-wires and 2 screws; no distortion or collimator (studied separately).
+FluoroscopyOptions studyOptions(bool foreignObjects) {
   FluoroscopyOptions o;
+  o.patient = PatientModel::CubicBspline;
+  o.patientExtension_mm = 60.0;
   o.tubeVoltage_kvp = 80.0;
+  o.scatterToPrimary = 0.1;
+  o.scatterSigma_mm = 40.0;
   o.photonsPerPixel = 10000.0;
   o.psfSigma_px = 0.7;
   o.vignetting = 0.1;
+  if (foreignObjects) {
+    o.kwireCount = 2;
+    o.screwCount = 2;
+  }
   return o;
 }
 
 }  // namespace
 
 std::string StudyXraySource::description() {
-  const FluoroscopyOptions o = studyOptions();
-  return fmt::format("FluoroscopySimulator on the original CT (exact material path lengths, {:g} kVp spectrum with "
-                     "NIST attenuation, automatic exposure, Poisson noise at {:g} photons per pixel at the reference level, PSF sigma {:g} px, vignetting "
-                     "{:g}; no distortion, collimator or foreign objects): a forward model independent of "
-                     "registration's DRR",
-                     o.tubeVoltage_kvp, o.photonsPerPixel, o.psfSigma_px, o.vignetting);
+  const FluoroscopyOptions o = studyOptions(true);
+  return fmt::format("FluoroscopySimulator on the original CT as a continuous patient (its cubic B-spline interpolant, "
+                     "continued {:g} mm beyond the CT's end faces by mirroring the end slabs; no voxel edges), {:g} kVp "
+                     "spectrum with NIST attenuation, scatter haze (scatter-to-primary {:g}, sigma {:g} mm), automatic "
+                     "exposure, Poisson noise at {:g} photons per pixel at the reference level, PSF sigma {:g} px, "
+                     "vignetting {:g}; realistic and bad scenarios add {} K-wires and {} screws that are not in the CT; "
+                     "no distortion or collimator): a forward model independent of registration's grid and DRR",
+                     o.patientExtension_mm, o.tubeVoltage_kvp, o.scatterToPrimary, o.scatterSigma_mm,
+                     o.photonsPerPixel, o.psfSigma_px, o.vignetting, o.kwireCount, o.screwCount);
 }
 
 Result<std::vector<RegistrationView>> StudyXraySource::simulate(const Volume& ct, const std::vector<ViewSpec>& views,
                                                                 const Eigen::Isometry3d& T_world_from_ct,
-                                                                std::uint32_t seed) {
-  FluoroscopyOptions options = studyOptions();
+                                                                std::uint32_t seed, bool foreignObjects) {
+  FluoroscopyOptions options = studyOptions(foreignObjects);
   options.seed = seed;
   std::vector<RegistrationView> out;
   for (std::size_t v = 0; v < views.size(); ++v) {

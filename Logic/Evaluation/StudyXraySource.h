@@ -1,7 +1,9 @@
 #pragma once
 // StudyXraySource: where a study's test X-rays and registration CTs come from (one seam, so the simulator can be
-// swapped without touching the studies). X-rays are always rendered from the ORIGINAL CT at the true pose; the
-// registration CT of the "realistic" and "bad" scenarios is the original resampled to a coarser slice spacing.
+// swapped without touching the studies). X-rays are always rendered from the ORIGINAL CT at the true pose, as a
+// continuous patient (its cubic B-spline interpolant, continued beyond the CT's end faces) with a scatter haze and,
+// when asked, K-wires and screws that are not in the CT; the registration CT of the "realistic" and "bad" scenarios
+// is the original resampled to a coarser slice spacing.
 
 #include <Eigen/Geometry>
 
@@ -22,9 +24,11 @@ class StudyXraySource {
   /// One line naming the forward model in use, for reports.
   static std::string description();
   /// Simulated X-rays of `ct` (LPS mm) at T_world_from_ct for every view (detector sizes from the cameras), view n
-  /// with noise seed `seed + n`. Fails, naming the view, on a rendering or simulation error.
+  /// with noise seed `seed + n`, with foreign objects (placed by `seed`) when `foreignObjects`. Fails, naming the
+  /// view, on a rendering or simulation error.
   static Result<std::vector<RegistrationView>> simulate(const Volume& ct, const std::vector<ViewSpec>& views,
-                                                        const Eigen::Isometry3d& T_world_from_ct, std::uint32_t seed);
+                                                        const Eigen::Isometry3d& T_world_from_ct, std::uint32_t seed,
+                                                        bool foreignObjects);
   /// The CT registration sees: `ct` resampled to `sliceSpacing_mm` along its slice axis with the matching
   /// slice-thickness blur (CtSliceDegrader), or `ct` itself when effectiveSliceSpacing_mm() is 0. Fails on a negative
   /// or non-finite spacing or a resampling error.

@@ -102,7 +102,8 @@ Result<std::vector<RegistrationObjective>> createObjectives(RegistrationCase& re
   std::vector<RegistrationObjective> objectives;
   for (const RegistrationStage& stage : schedule.stages) {
     auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
-                                                 ablation.noCtPyramid ? std::nullopt : std::optional(T_initial));
+                                                 ablation.noCtPyramid ? std::nullopt : std::optional(T_initial),
+                                                 std::optional(T_initial));
     if (!created) return fail(created.error());
     objectives.push_back(std::move(created).value());
   }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "Drr/CutFaceRayMask.h"
 #include "Geometry/RigidPose.h"
 #include "Search/PoseOptimizer.h"
 
@@ -36,6 +37,10 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   if (!renderer) return fail(renderer.error());
   result.m_renderer = std::move(renderer).value();
   result.m_viewRenderersReady = options.drr.method != DrrMethod::Transgraph;
+  if (!(options.cutFaceMargin_mm <= 500.0)) {  // also NaN
+    return fail(fmt::format("cut-face margin must be at most 500 mm (negative: off), got {}", options.cutFaceMargin_mm));
+  }
+  result.m_cutFaceMargin_mm = options.cutFaceMargin_mm;
 
   for (const RegistrationView& view : views) {
     const CameraIntrinsics& in = view.camera.intrinsics();
@@ -184,6 +189,15 @@ Result<RoiSelection> RegistrationCase::allWindows(std::size_t v, int level, int 
   auto selector = this->selector(v, level, windowSize);
   if (!selector) return fail(selector.error());
   return selector.value()->selectAll();
+}
+
+Result<ValidMask> RegistrationCase::cutFaceMask(std::size_t v, int level,
+                                                const Eigen::Isometry3d& T_world_from_ct) const {
+  if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
+  const PyramidLevel& pyramidLevel = m_views[v].prepared.pyramid.level(level);
+  if (m_cutFaceMargin_mm < 0.0) return ValidMask::allValid(pyramidLevel.image.cols, pyramidLevel.image.rows);
+  if (!pyramidLevel.camera) return fail(fmt::format("view '{}', level {}: no camera", m_views[v].name, level));
+  return CutFaceRayMask::compute(*pyramidLevel.camera, T_world_from_ct, *m_drrVolume, m_cutFaceMargin_mm);
 }
 
 Status RegistrationCase::checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const {

@@ -42,6 +42,11 @@ struct RegistrationCaseOptions {
   DrrRendererOptions drr;                  ///< DRR method ("siddon", "raycast", ...)
   XrayPreparationOptions preparation;      ///< masks, intensity model, pyramid levels (spheres come per view)
   double boneThreshold_hu = 250.0;         ///< iso-value of the bone surface giving the rotation centre and radius
+  /// Pixels whose rays cross the patient beyond the CT's end faces along its slice axis, or pass within this many mm
+  /// of them, at the initial pose, are left out of the comparison (CutFaceRayMask): the X-ray shows anatomy there
+  /// that the CT lacks. Negative: off (the default: the mask is made at the initial pose, so it is only as right as
+  /// that pose; the evaluation studies use 5 mm).
+  double cutFaceMargin_mm = -1.0;
   /// Transgraph method: the pose (CT mm -> world mm, LPS) around which each view's table is built, e.g. the initial
   /// pose from landmarks. nullopt: the tables are built at the initial pose of the first Registration::run.
   std::optional<Eigen::Isometry3d> T_expected_world_from_ct;
@@ -112,6 +117,10 @@ class RegistrationCase {
   /// Every complete valid windowSize^2 window of view v at `level` (VLNC without dynamic ROIs); fails as rois().
   Result<RoiSelection> allWindows(std::size_t v, int level, int windowSize);
 
+  /// The CutFaceRayMask of view v at `level` with the CT at T_world_from_ct and the case's cut-face margin; every
+  /// pixel valid when the margin is negative (off). Fails on a bad view or level, or a view without a level camera.
+  Result<ValidMask> cutFaceMask(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const;
+
   /// Checks that the CT at `T_world_from_ct` projects onto the valid pixels of every view at `level`: fails, naming
   /// the view, when the DRR is empty (zero) over all of them, i.e. the DRR and the X-ray do not overlap.
   Status checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const;
@@ -138,6 +147,7 @@ class RegistrationCase {
   std::map<std::array<int, 3>, std::shared_ptr<const DrrRenderer>> m_coarseRenderers;  ///< by CT block size
   DrrRendererOptions m_drrOptions;
   bool m_viewRenderersReady = true;
+  double m_cutFaceMargin_mm = -1.0;
   double m_viewRendererSetup_s = 0.0;
   std::vector<View> m_views;
   std::optional<BoneSurface> m_bone;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "Similarity/GradientCorrelationSimilarity.h"
@@ -26,11 +27,69 @@ PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int maxPixels) {
   return kept;
 }
 
+/// The pixels of `pixels` valid in `mask`.
+PixelIndexList keepValid(const PixelIndexList& pixels, const ValidMask& mask) {
+  PixelIndexList kept;
+  kept.reserve(pixels.size());
+  for (const std::int32_t index : pixels) {
+    if (mask.valid[static_cast<std::size_t>(index)]) kept.push_back(index);
+  }
+  return kept;
+}
+
+/// The windows of `selection` whose every pixel is valid in `mask`, with their pixels.
+RoiSelection keepValidWindows(const RoiSelection& selection, const ValidMask& mask) {
+  RoiSelection kept = selection;
+  kept.windows.clear();
+  kept.pixels.clear();
+  const std::size_t windowPixels = static_cast<std::size_t>(selection.windowSize) * selection.windowSize;
+  for (std::size_t w = 0; w < selection.windows.size(); ++w) {
+    const auto first = selection.pixels.begin() + static_cast<std::ptrdiff_t>(w * windowPixels);
+    const auto last = first + static_cast<std::ptrdiff_t>(windowPixels);
+    if (!std::all_of(first, last, [&](std::int32_t index) { return mask.valid[static_cast<std::size_t>(index)] != 0; })) {
+      continue;
+    }
+    kept.windows.push_back(selection.windows[w]);
+    kept.pixels.insert(kept.pixels.end(), first, last);
+  }
+  return kept;
+}
+
+/// The highest-variance windows of `selection` covering round(targetFraction × validPixels) pixels (at least one
+/// window, if any), in raster order — DynamicRoiSelector::selectFraction over a reduced candidate set.
+RoiSelection strongestWindows(const RoiSelection& selection, double targetFraction, std::size_t validPixels) {
+  const std::size_t windowPixels = static_cast<std::size_t>(selection.windowSize) * selection.windowSize;
+  const auto wanted = static_cast<std::size_t>(std::lround(targetFraction * validPixels / double(windowPixels)));
+  const std::size_t count = std::min(std::max<std::size_t>(wanted, 1), selection.windows.size());
+  std::vector<std::size_t> order(selection.windows.size());
+  for (std::size_t w = 0; w < order.size(); ++w) order[w] = w;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return selection.windows[a].normalizedVariance > selection.windows[b].normalizedVariance;
+  });
+  order.resize(count);
+  std::sort(order.begin(), order.end());  // back to raster order
+  RoiSelection kept = selection;
+  kept.windows.clear();
+  kept.pixels.clear();
+  for (const std::size_t w : order) {
+    kept.windows.push_back(selection.windows[w]);
+    const auto first = selection.pixels.begin() + static_cast<std::ptrdiff_t>(w * windowPixels);
+    kept.pixels.insert(kept.pixels.end(), first, first + static_cast<std::ptrdiff_t>(windowPixels));
+  }
+  if (!kept.windows.empty()) {
+    kept.threshold = kept.windows.front().normalizedVariance;
+    for (const RoiWindow& window : kept.windows) kept.threshold = std::min<double>(kept.threshold, window.normalizedVariance);
+  }
+  kept.keptFraction = validPixels ? static_cast<double>(kept.pixels.size()) / static_cast<double>(validPixels) : 0.0;
+  return kept;
+}
+
 }  // namespace
 
 Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& registrationCase,
                                                             const RegistrationStage& stage, bool useViewRenderers,
-                                                            const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct) {
+                                                            const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct,
+                                                            const std::optional<Eigen::Isometry3d>& T_cutFaces_world_from_ct) {
   RegistrationObjective objective;
   objective.m_level = stage.level;
   const int level = stage.level;
@@ -51,25 +110,55 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
       view.renderer = levelRenderer.value();
     }
     view.camera = registrationCase.camera(v);
-    const std::size_t validCount = pyramidLevel.mask.validCount();
+    std::optional<ValidMask> cutFaces;
+    if (T_cutFaces_world_from_ct) {
+      auto mask = registrationCase.cutFaceMask(v, level, *T_cutFaces_world_from_ct);
+      if (!mask) return fail(fmt::format("{}: {}", where(v), mask.error()));
+      cutFaces = std::move(mask).value();
+    }
+    // The pixels the comparison may use: valid, and clear of the cut faces when those are left out.
+    std::size_t validCount =
+        cutFaces ? keepValid(pyramidLevel.mask.pixelList(), *cutFaces).size() : pyramidLevel.mask.validCount();
 
     // The pixel set: windows for VLNC and for ROIs, the valid pixels otherwise.
     const bool windows = stage.metric == SimilarityMetric::Vlnc || stage.pixels.kind == PixelSetKind::Rois;
     RoiSelection selection;
     if (windows) {
-      auto selected = stage.pixels.kind == PixelSetKind::Rois
+      const bool rois = stage.pixels.kind == PixelSetKind::Rois;
+      // With cut faces, the ROIs are the strongest of the windows clear of them.
+      auto selected = rois && !cutFaces
                           ? registrationCase.rois(v, level, stage.pixels.windowSize, stage.pixels.targetFraction)
                           : registrationCase.allWindows(v, level, stage.pixels.windowSize);
       if (!selected) return fail(fmt::format("stage '{}': {}", stage.name, selected.error()));
       selection = std::move(selected).value();
+      if (cutFaces) {
+        RoiSelection clear = keepValidWindows(selection, *cutFaces);
+        if (clear.windows.empty()) {  // no window clear of the cut faces at this level: keep the unmasked ROIs
+          auto unmasked = rois ? registrationCase.rois(v, level, stage.pixels.windowSize, stage.pixels.targetFraction)
+                               : Result<RoiSelection>(selection);
+          if (!unmasked) return fail(fmt::format("stage '{}': {}", stage.name, unmasked.error()));
+          selection = std::move(unmasked).value();
+          validCount = pyramidLevel.mask.validCount();
+        } else {
+          selection = rois ? strongestWindows(clear, stage.pixels.targetFraction, validCount) : std::move(clear);
+        }
+      }
       view.pixels = selection.pixels;
     } else {
       view.pixels = pyramidLevel.mask.pixelList();
+      if (cutFaces) {
+        PixelIndexList clear = keepValid(view.pixels, *cutFaces);
+        if (!clear.empty()) {
+          view.pixels = std::move(clear);
+        } else {  // every valid ray crosses them: keep all
+          validCount = pyramidLevel.mask.validCount();
+        }
+      }
       if (stage.pixels.maxPixels > 0) view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stage.pixels.maxPixels);
     }
     if (view.pixels.empty()) {
-      return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}); reduce the masks or use a "
-                              "finer level",
+      return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}, or every ray crosses the CT's "
+                              "cut faces); reduce the masks, the cut-face margin, or use a finer level",
                               where(v), level));
     }
     view.keptFraction = validCount ? static_cast<double>(view.pixels.size()) / static_cast<double>(validCount) : 0.0;

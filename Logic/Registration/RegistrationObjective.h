@@ -30,10 +30,14 @@ class RegistrationObjective {
   /// view, on a level the pyramid lacks or a pixel set that cannot be built (no complete valid window, ...).
   /// With useViewRenderers false every view uses the case's exact renderer (the Transgraph switched off). Exact
   /// renderers integrate the full CT, or, given T_coarseCt_world_from_ct, the CT coarsened to the stage level's pixel
-  /// footprint at that pose (RegistrationCase::levelRenderer; the CT pyramid).
+  /// footprint at that pose (RegistrationCase::levelRenderer; the CT pyramid). Given T_cutFaces_world_from_ct, the
+  /// pixels (VLNC: the windows with a pixel) whose rays at that pose cross the CT's cut faces are left out
+  /// (RegistrationCase::cutFaceMask), unless that leaves a view no pixel (no complete window for VLNC): then that view
+  /// keeps its unmasked set in that stage.
   static Result<RegistrationObjective> create(
       RegistrationCase& registrationCase, const RegistrationStage& stage, bool useViewRenderers = true,
-      const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct = std::nullopt);
+      const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct = std::nullopt,
+      const std::optional<Eigen::Isometry3d>& T_cutFaces_world_from_ct = std::nullopt);
 
   /// S(T) in [-1, 1] for the CT at T_world_from_ct (see the file comment). Fails on a rendering or metric error.
   Result<double> similarity(const Eigen::Isometry3d& T_world_from_ct);

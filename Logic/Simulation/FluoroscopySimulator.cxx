@@ -12,6 +12,7 @@
 #include "Base/SeededRandom.h"
 #include "Simulation/ForeignObjectSet.h"
 #include "Simulation/IntensifierDistortion.h"
+#include "Simulation/Physics/CubicBsplinePatient.h"
 #include "Simulation/Physics/MaterialPathTracer.h"
 #include "Simulation/Physics/XraySpectrum.h"
 
@@ -19,12 +20,21 @@ namespace fct {
 
 namespace {
 
-/// What every view of a case shares: the spectrum with its attenuation table, the CT tracer and the implants.
+/// What every view of a case shares: the spectrum with its attenuation table, the patient (one of the two models)
+/// and the implants.
 struct Scene {
   XraySpectrum spectrum;
   std::vector<MassPaths> massAttenuation_cm2_per_g;  ///< per bin, per material
-  std::optional<MaterialPathTracer> tracer;           ///< none for a scene without patient (a grid plate image)
+  std::optional<CubicBsplinePatient> continuousPatient;  ///< the patient model in use; neither for a scene without
+  std::optional<MaterialPathTracer> voxelPatient;         ///< patient (a grid plate image)
   ForeignObjectSet implants;  ///< CT frame
+
+  /// The patient's mass paths along a ray (CT frame); zero without a patient.
+  MassPaths trace(const Eigen::Vector3d& origin_ct_mm, const Eigen::Vector3d& direction_ct) const {
+    if (continuousPatient) return continuousPatient->trace(origin_ct_mm, direction_ct);
+    if (voxelPatient) return voxelPatient->trace(origin_ct_mm, direction_ct);
+    return MassPaths{};
+  }
 };
 
 /// What a view shows: the patient with its implants and the calibration spheres the options ask for, or only the
@@ -53,6 +63,15 @@ Status validate(const FluoroscopyOptions& o) {
                             o.photonsPerPixel));
   }
   if (bad(o.psfSigma_px, 0.0, 20.0)) return fail(fmt::format("PSF sigma must be 0..20 px, got {}", o.psfSigma_px));
+  if (bad(o.scatterToPrimary, 0.0, 5.0)) {
+    return fail(fmt::format("scatter-to-primary ratio must be 0..5, got {}", o.scatterToPrimary));
+  }
+  if (bad(o.scatterSigma_mm, 1.0, 500.0)) {
+    return fail(fmt::format("scatter haze sigma must be 1..500 mm, got {}", o.scatterSigma_mm));
+  }
+  if (o.patient == PatientModel::VoxelBoxes && o.patientExtension_mm != 0.0) {
+    return fail("a patient extension beyond the CT needs the continuous (cubic B-spline) patient model");
+  }
   if (!(o.gain > 0.0 && std::isfinite(o.gain))) return fail(fmt::format("gain must be positive, got {}", o.gain));
   if (!std::isfinite(o.offset)) return fail(fmt::format("offset must be finite, got {}", o.offset));
   if (bad(o.gamma, 0.1, 10.0)) return fail(fmt::format("gamma must be 0.1..10, got {}", o.gamma));
@@ -78,22 +97,28 @@ Status checkRigid(const Eigen::Isometry3d& T) {
   return Ok{};
 }
 
-/// Builds the spectrum, attenuation table, tracer and implants shared by every view (no tracer or implants without
+/// Builds the spectrum, attenuation table, patient model and implants shared by every view (neither without
 /// a CT).
 Result<Scene> prepareScene(const Volume* ct, const FluoroscopyOptions& options) {
   if (Status valid = validate(options); !valid) return fail(valid.error());
   auto spectrum = XraySpectrum::create(spectrumOptions(options));
   if (!spectrum.ok()) return fail(spectrum.error());
-  Scene scene{std::move(spectrum).value(), {}, std::nullopt, ForeignObjectSet()};
+  Scene scene{std::move(spectrum).value(), {}, std::nullopt, std::nullopt, ForeignObjectSet()};
   if (ct) {
-    auto tracer = MaterialPathTracer::create(*ct, options.materials);
-    if (!tracer.ok()) return fail(tracer.error());
     auto implants = ForeignObjectSet::placeNearBone(
         *ct, {options.kwireCount, options.screwCount, options.plate, options.gasPocketCount, options.boneThreshold_hu,
               options.seed});
     if (!implants.ok()) return fail(implants.error());
-    scene.tracer = std::move(tracer).value();
     scene.implants = std::move(implants).value();
+    if (options.patient == PatientModel::CubicBspline) {
+      auto patient = CubicBsplinePatient::create(*ct, options.materials, options.patientExtension_mm);
+      if (!patient.ok()) return fail(patient.error());
+      scene.continuousPatient = std::move(patient).value();
+    } else {
+      auto tracer = MaterialPathTracer::create(*ct, options.materials);
+      if (!tracer.ok()) return fail(tracer.error());
+      scene.voxelPatient = std::move(tracer).value();
+    }
   }
   for (const SpectrumBin& bin : scene.spectrum.bins()) {
     MassPaths mu{};
@@ -186,20 +211,22 @@ Result<ForeignObjectSet> detectorObjectsFor(const Camera& camera, const Fluorosc
                                            options.sphereDistanceFromDetector_mm);
 }
 
-/// Per pixel (row-major): the mass paths of its ray, and whether the collimator lets it through.
+/// Per pixel (row-major): the mass paths of its ray, whether the collimator lets it through, and its noiseless
+/// scatter signal (empty without a scatter haze).
 struct LineIntegrals {
   std::vector<MassPaths> pixelPaths;
   std::vector<std::uint8_t> exposed;
+  std::vector<float> scatter;
 };
 
-/// Pass 1: exact material path integrals through the CT and the implants (for the patient, when the scene has them)
-/// and the detector-fixed spheres for every pixel inside the collimator, with their noiseless signal written to
-/// `image` (pixels outside stay 0).
+/// Pass 1: material path integrals through the patient and the implants (when the view shows the patient and the
+/// scene has one) and the detector-fixed spheres for every pixel inside the collimator, with their noiseless signal
+/// written to `image` (pixels outside stay 0).
 LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, const ForeignObjectSet& spheres,
                                  const SpectrumWeights& weights, ViewContent content, FloatImage& image) {
   const bool patient = content == ViewContent::Patient;
   const std::size_t pixelCount = static_cast<std::size_t>(g.in.cols) * g.in.rows;
-  LineIntegrals rays{std::vector<MassPaths>(pixelCount), std::vector<std::uint8_t>(pixelCount, 0)};
+  LineIntegrals rays{std::vector<MassPaths>(pixelCount), std::vector<std::uint8_t>(pixelCount, 0), {}};
   tbb::parallel_for(0, g.in.rows, [&](int row) {
     std::vector<double> transmission(weights.energyWeight.size());
     for (int col = 0; col < g.in.cols; ++col) {
@@ -209,8 +236,10 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
           Eigen::Vector3d((col - g.K(0, 2)) / g.K(0, 0), (row - g.K(1, 2)) / g.K(1, 1), 1.0).normalized();
       const Eigen::Vector3d direction_ct = g.R_ct_from_camera * direction_camera;
       MassPaths& paths = rays.pixelPaths[index];
-      if (patient && scene.tracer) paths = scene.tracer->trace(g.source_ct, direction_ct);
-      if (patient) scene.implants.accumulate(g.source_ct, direction_ct, paths);
+      if (patient) {
+        paths = scene.trace(g.source_ct, direction_ct);
+        scene.implants.accumulate(g.source_ct, direction_ct, paths);
+      }
       spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
       for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
       image.pixels[index] = static_cast<float>(noiselessSignal(scene, weights, paths, transmission));
@@ -218,6 +247,29 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
     }
   });
   return rays;
+}
+
+/// The scatter haze: scatterToPrimary times the noiseless primary signal of `image` blurred by a Gaussian of
+/// scatterSigma_mm on the detector (pixels outside the collimator add nothing and get nothing), kept in
+/// rays.scatter and added to `image`. Nothing without a haze; fails on an OpenCV error.
+Status addScatterHaze(const FluoroscopyOptions& options, const CameraIntrinsics& in, LineIntegrals& rays,
+                      FloatImage& image) {
+  if (options.scatterToPrimary <= 0.0) return Ok{};
+  const double sigma_px = options.scatterSigma_mm / in.pixelSpacing_mm.mean();
+  try {
+    cv::Mat primary(image.rows, image.cols, CV_32F, image.pixels.data());
+    cv::Mat haze;
+    cv::GaussianBlur(primary, haze, cv::Size(0, 0), sigma_px, sigma_px, cv::BORDER_REFLECT);
+    rays.scatter.assign(image.pixels.size(), 0.0f);
+    for (std::size_t index = 0; index < image.pixels.size(); ++index) {
+      if (!rays.exposed[index]) continue;
+      rays.scatter[index] = static_cast<float>(options.scatterToPrimary * haze.at<float>(static_cast<int>(index)));
+      image.pixels[index] += rays.scatter[index];
+    }
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("scatter haze failed: {}", e.what()));
+  }
+  return Ok{};
 }
 
 /// Sets the view's maxLineIntegral and referenceSignal (automatic exposure: the 99th percentile of the exposed
@@ -241,7 +293,7 @@ Status measureExposure(const std::vector<std::uint8_t>& exposed, const Fluorosco
 }
 
 /// Pass 2: exposure scaling of every exposed pixel by the reference signal and, with a dose, Poisson quantum noise per
-/// energy bin (one random stream per row, from viewSeed).
+/// energy bin, and for the scatter haze at the spectrum's mean energy (one random stream per row, from viewSeed).
 void exposeWithQuantumNoise(const Scene& scene, const SpectrumWeights& weights, const LineIntegrals& rays,
                             const FluoroscopyOptions& options, std::uint32_t viewSeed, double referenceSignal,
                             FloatImage& image) {
@@ -262,6 +314,9 @@ void exposeWithQuantumNoise(const Scene& scene, const SpectrumWeights& weights, 
       for (std::size_t b = 0; b < transmission.size(); ++b) {
         energy += static_cast<double>(random.poisson(photons * weights.photonFraction[b] * transmission[b])) *
                   scene.spectrum.bins()[b].energy_keV;
+      }
+      if (!rays.scatter.empty()) {
+        energy += static_cast<double>(random.poisson(photons * rays.scatter[index])) * weights.energyNorm;
       }
       out = static_cast<float>(energy / (options.photonsPerPixel * weights.energyNorm));
     }
@@ -341,7 +396,8 @@ Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const 
 
   RenderedView view;
   view.image = FloatImage::filled(geometry.in.cols, geometry.in.rows);
-  const LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, content, view.image);
+  LineIntegrals rays = traceLineIntegrals(scene, geometry, spheres.value(), weights, content, view.image);
+  if (Status haze = addScatterHaze(options, geometry.in, rays, view.image); !haze) return fail(haze.error());
   if (Status exposure = measureExposure(rays.exposed, options, view); !exposure) return fail(exposure.error());
   exposeWithQuantumNoise(scene, weights, rays, options, viewSeed, view.referenceSignal, view.image);
   if (Status blurred = blurPointSpread(options.psfSigma_px, view.image); !blurred) return fail(blurred.error());
@@ -364,9 +420,13 @@ nlohmann::ordered_json optionsJson(const FluoroscopyOptions& o) {
   j["hu_bone_from"] = o.materials.boneFrom_hu;
   j["hu_cortical_bone"] = o.materials.corticalBone_hu;
   j["hu_metal_from"] = o.materials.metalFrom_hu;
+  j["patient_model"] = o.patient == PatientModel::CubicBspline ? "cubic_bspline" : "voxel_boxes";
+  j["patient_extension_mm"] = o.patientExtension_mm;
   j["automatic_exposure"] = o.automaticExposure;
   j["photons_per_pixel"] = o.photonsPerPixel;
   j["psf_sigma_px"] = o.psfSigma_px;
+  j["scatter_to_primary"] = o.scatterToPrimary;
+  j["scatter_sigma_mm"] = o.scatterSigma_mm;
   j["gain"] = o.gain;
   j["offset"] = o.offset;
   j["gamma"] = o.gamma;

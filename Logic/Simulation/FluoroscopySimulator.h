@@ -3,12 +3,14 @@
 // registration's DRR (no DrrVolume, DrrRenderer, Siddon or Transgraph code), so that registration results on its
 // images are not an "inverse crime".
 //
-// Per detector pixel: one ray from the source through the pixel centre; MaterialPathTracer walks the ORIGINAL CT
-// voxels with exact path lengths and returns the mass per area of air, soft tissue, cortical bone and metal
-// (HuMaterialModel); objects that are not in the CT (K-wires, screws, a plate near the bone; calibration-grid
+// Per detector pixel: one ray from the source through the pixel centre, integrated through the patient — by default
+// the continuous cubic B-spline interpolant of the CT, optionally continued beyond the CT's end faces
+// (CubicBsplinePatient), so no voxel edge of the CT shows; or the CT's own voxel boxes with exact path lengths
+// (MaterialPathTracer) — into the mass per area of air, soft tissue, cortical bone and metal (HuMaterialModel); objects that are not in the CT (K-wires, screws, a plate near the bone; calibration-grid
 // spheres fixed to the C-arm) add their analytic chord lengths (ForeignObjectSet). Beer–Lambert per bin of a
 // polyenergetic tube spectrum (XraySpectrum) with NIST µ/ρ (MassAttenuationTable) gives the transmitted photons;
-// an energy-integrating detector weights them by energy. Then, in order: a circular collimator (no photons outside),
+// an energy-integrating detector weights them by energy. A scatter haze adds scatterToPrimary times the primary
+// signal blurred by a Gaussian of scatterSigma_mm on the detector (a broad, low-contrast background). Then, in order: a circular collimator (no photons outside),
 // Poisson quantum noise per energy bin at the given dose, a Gaussian point-spread function, image-intensifier
 // pincushion / S-distortion (IntensifierDistortion), vignetting, and the display transfer gain · s^gamma + offset.
 //
@@ -33,6 +35,12 @@
 
 namespace fct {
 
+/// How the simulator turns the CT into a patient.
+enum class PatientModel {
+  CubicBspline,  ///< the continuous cubic B-spline interpolant of the CT (CubicBsplinePatient)
+  VoxelBoxes,    ///< the CT's voxel boxes with exact path lengths (MaterialPathTracer): carries the CT's staircase
+};
+
 /// Every parameter of the physical simulation. Defaults: an ideal noiseless detector at 80 kVp, no
 /// intensifier effects, no foreign objects; each effect is switched on by its parameter.
 struct FluoroscopyOptions {
@@ -42,6 +50,8 @@ struct FluoroscopyOptions {
   double spectrumBinWidth_keV = 5.0;  ///< energy bin width, 1..20 keV
   double monochromatic_keV = 0.0;     ///< > 0: a monochromatic beam at this energy (10..150 keV) instead of the spectrum
   HuMaterialModel materials;          ///< HU -> material densities
+  PatientModel patient = PatientModel::CubicBspline;  ///< the patient the rays cross
+  double patientExtension_mm = 0.0;   ///< CubicBspline: the patient continues this far beyond the CT's end faces, 0..1000
   // Exposure, dose and detector.
   /// Automatic exposure (a C-arm's brightness control): the tube output is scaled per view so that the reference
   /// level — the 99th percentile of the noiseless signal over the exposed pixels — receives photonsPerPixel photons
@@ -49,6 +59,8 @@ struct FluoroscopyOptions {
   bool automaticExposure = true;
   double photonsPerPixel = 0.0;       ///< photons per pixel at the reference level (all bins); 0 = noiseless
   double psfSigma_px = 0.0;           ///< Gaussian point-spread function sigma in pixels; 0 = none
+  double scatterToPrimary = 0.0;      ///< scatter haze: this fraction of the blurred primary signal is added, 0..5
+  double scatterSigma_mm = 40.0;      ///< scatter haze: Gaussian sigma on the detector in mm, 1..500
   double gain = 50000.0;              ///< pixel value of the reference level, before offset
   double offset = 0.0;                ///< added to every pixel (dark level)
   double gamma = 1.0;                 ///< display gamma applied to the signal, > 0

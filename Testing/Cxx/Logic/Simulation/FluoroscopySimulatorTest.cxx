@@ -280,6 +280,35 @@ TEST(FluoroscopySimulator, WritesAGridPlateImagePerViewAndNoInputDewarpFile) {
   EXPECT_FALSE(fct::FluoroscopySimulator::renderGridPlate(views[1].camera, options, 1).ok());
 }
 
+TEST(FluoroscopySimulator, ScatterHazeAddsItsFractionOfTheBlurredPrimary) {
+  // Behind a wide uniform slab the primary is flat, so its blur is itself: the haze adds f times it.
+  const fct::Volume ct = waterSlab(100.0);
+  fct::FluoroscopyOptions options = absolute();
+  options.monochromatic_keV = 60.0;
+  const fct::Camera camera = axialCamera(41, 31, 0.5);
+  const float primary = fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), options, 1)
+                            .value()
+                            .at(20, 15);
+  options.scatterToPrimary = 0.2;
+  options.scatterSigma_mm = 2.0;
+  const float hazy = fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), options, 1)
+                         .value()
+                         .at(20, 15);
+  EXPECT_NEAR(hazy, 1.2f * primary, 1e-3 * primary);
+}
+
+TEST(FluoroscopySimulator, VoxelBoxPatientMatchesTheContinuousOneInsideAUniformSlab) {
+  const fct::Volume ct = waterSlab(100.0);
+  fct::FluoroscopyOptions options = absolute();
+  options.monochromatic_keV = 60.0;
+  const float continuous =
+      fct::FluoroscopySimulator::render(ct, axialCamera(), Eigen::Isometry3d::Identity(), options, 1).value().at(20, 15);
+  options.patient = fct::PatientModel::VoxelBoxes;
+  const float boxes =
+      fct::FluoroscopySimulator::render(ct, axialCamera(), Eigen::Isometry3d::Identity(), options, 1).value().at(20, 15);
+  EXPECT_NEAR(continuous, boxes, 1e-6);
+}
+
 TEST(FluoroscopySimulator, RejectsBadInput) {
   const fct::Volume ct = waterSlab(40.0);
   const fct::Camera camera = axialCamera();
@@ -297,6 +326,13 @@ TEST(FluoroscopySimulator, RejectsBadInput) {
   fct::FluoroscopyOptions badGamma;
   badGamma.gamma = 0.0;
   EXPECT_FALSE(fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), badGamma, 1).ok());
+  fct::FluoroscopyOptions badScatter;
+  badScatter.scatterToPrimary = -0.1;
+  EXPECT_FALSE(fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), badScatter, 1).ok());
+  fct::FluoroscopyOptions extendedBoxes;
+  extendedBoxes.patient = fct::PatientModel::VoxelBoxes;
+  extendedBoxes.patientExtension_mm = 10.0;
+  EXPECT_FALSE(fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), extendedBoxes, 1).ok());
   fct::FluoroscopyOptions noBone;
   noBone.kwireCount = 1;
   EXPECT_FALSE(fct::FluoroscopySimulator::render(ct, camera, Eigen::Isometry3d::Identity(), noBone, 1).ok());

@@ -1,0 +1,67 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "Drr/CutFaceRayMask.h"
+#include "Simulation/StandardViews.h"
+
+namespace {
+
+/// A 2 mm CT of 40 x 40 x 20 voxels centred on the world origin: air with a tissue cylinder (radius 20 mm, along k)
+/// through every slice, or ending two slices before each end face when `airAtTheEnds`.
+fct::DrrVolume cylinderCt(bool airAtTheEnds) {
+  fct::Volume ct = fct::Volume::create(Eigen::Vector3i(40, 40, 20), Eigen::Vector3d(2, 2, 2),
+                                       Eigen::Vector3d(-39, -39, -19), Eigen::Matrix3d::Identity(), -1000.0f)
+                       .value();
+  for (int k = airAtTheEnds ? 2 : 0; k < (airAtTheEnds ? 18 : 20); ++k)
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i) {
+        const Eigen::Vector3d p = ct.lpsFromIjk(Eigen::Vector3d(i, j, k));
+        if (p.head<2>().norm() < 20.0) ct.at(i, j, k) = 0.0f;
+      }
+  return fct::DrrVolume::create(ct).value();
+}
+
+/// The first standard view (AP: rays across the slice axis), 128 x 128 at 1 mm.
+fct::Camera apCamera() {
+  fct::StandardViewOptions options;
+  options.count = 1;
+  options.cols = options.rows = 128;
+  options.pixelSpacing_mm = 1.0;
+  return fct::StandardViews::build(Eigen::Vector3d::Zero(), options).value().front().camera;
+}
+
+/// Whether the pixel where `p_world_mm` projects is valid in `mask`.
+bool validAt(const fct::ValidMask& mask, const fct::Camera& camera, const Eigen::Vector3d& p_world_mm) {
+  const Eigen::Vector2d uv = camera.project(p_world_mm);
+  return mask.isValid(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));
+}
+
+}  // namespace
+
+TEST(CutFaceRayMask, LeavesOutRaysOverThePatientBeyondACutFace) {
+  const fct::Camera camera = apCamera();
+  auto mask = fct::CutFaceRayMask::compute(camera, Eigen::Isometry3d::Identity(), cylinderCt(false), 5.0);
+  ASSERT_TRUE(mask.ok()) << mask.error();
+  EXPECT_TRUE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 0)));         // through the middle of the slab
+  EXPECT_TRUE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 10)));        // 10 mm inside the top face
+  EXPECT_FALSE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 18)));       // within the margin of it
+  EXPECT_FALSE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 35)));       // beyond it, over the cylinder
+  EXPECT_FALSE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, -35)));      // beyond the bottom face
+  EXPECT_TRUE(validAt(mask.value(), camera, Eigen::Vector3d(40, 0, 35)));       // beside the cylinder's footprint
+}
+
+TEST(CutFaceRayMask, KeepsEveryRayWhenTheEndSlicesHoldNoPatient) {
+  const fct::Camera camera = apCamera();
+  const fct::ValidMask mask =
+      fct::CutFaceRayMask::compute(camera, Eigen::Isometry3d::Identity(), cylinderCt(true), 5.0).value();
+  EXPECT_EQ(mask.validCount(), static_cast<std::size_t>(128 * 128));
+}
+
+TEST(CutFaceRayMask, RejectsABadMargin) {
+  const fct::DrrVolume volume = cylinderCt(false);
+  for (double margin : {-1.0, 600.0, std::numeric_limits<double>::quiet_NaN()}) {
+    EXPECT_FALSE(fct::CutFaceRayMask::compute(apCamera(), Eigen::Isometry3d::Identity(), volume, margin).ok()) << margin;
+  }
+}
