@@ -31,6 +31,22 @@ std::filesystem::path scratchDir() {
   return dir;
 }
 
+std::filesystem::path workDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const auto dir = scratchDir().parent_path() / (std::string(info ? info->name() : "fct_test") + "_files");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 std::filesystem::path cliPath() { return FCT_CLI_PATH; }
 
 std::filesystem::path scriptPath(const std::string& name) { return std::filesystem::path(FCT_SCRIPT_DIR) / name; }

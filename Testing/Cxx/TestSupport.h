@@ -14,6 +14,10 @@ bool hasData(const std::string& relative);
 std::filesystem::path fixtureDir();
 /// A fresh, empty scratch folder unique to the running test (removed and recreated on each call).
 std::filesystem::path scratchDir();
+/// A fresh, empty folder for this test's files beside scratchDir(), so a later scratchDir() call does not empty it.
+std::filesystem::path workDir();
+/// The whole text of a file; records a test failure and returns an empty string if it cannot be read.
+std::string readText(const std::filesystem::path& path);
 /// Path of the built `fluoroct` command-line program.
 std::filesystem::path cliPath();
 /// Path of a script in the repository's scripts/ folder, e.g. scriptPath("study-parallel.sh").

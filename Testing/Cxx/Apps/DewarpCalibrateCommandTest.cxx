@@ -10,15 +10,6 @@
 
 namespace {
 
-/// A fresh folder for this test's files (runCli() wipes scratchDir() on each call, so the files live beside it).
-std::filesystem::path workDir() {
-  const auto dir = fct::test::scratchDir().parent_path() /
-                   (std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_files");
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
 /// A one-view simulated case with pincushion and S-distortion and its grid plate image DIR/case/ap_grid.png.
 void simulateDistortedCase(const std::filesystem::path& dir) {
   ASSERT_EQ(fct::test::runCli(fmt::format("phantom --out '{}' --dims 40 40 30 --spacing-mm 4", (dir / "ct.nrrd").string()))
@@ -49,7 +40,7 @@ std::string oneErrorLine(const std::string& command) {
 }  // namespace
 
 TEST(DewarpCalibrateCommand, CalibratesTheSimulatedGridWithinAThirdOfAPixelAndWritesTheFile) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   simulateDistortedCase(dir);
   const auto out = dir / "ii.dewarp.json";
   const auto run = fct::test::runCli(fmt::format("dewarp-calibrate '{}' --pitch-mm 10 --pixel-spacing-mm 0.8 --out '{}'",
@@ -68,7 +59,7 @@ TEST(DewarpCalibrateCommand, CalibratesTheSimulatedGridWithinAThirdOfAPixelAndWr
 }
 
 TEST(DewarpCalibrateCommand, WrongPitchNoGridAndMissingImageAreOneLineErrorsThatWriteNothing) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   simulateDistortedCase(dir);
   const auto out = dir / "never.json";
   const std::string wrongPitch = oneErrorLine(fmt::format("dewarp-calibrate '{}' --pitch-mm 25 --pixel-spacing-mm 0.8 "

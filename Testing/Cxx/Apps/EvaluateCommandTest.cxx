@@ -21,12 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string readText(const fs::path& path) {
-  auto text = fct::TextFile::read(path);
-  EXPECT_TRUE(text.ok()) << text.error();
-  return text.ok() ? text.value() : std::string();
-}
-
 /// Width and height from a PNG's signature and IHDR chunk; (0, 0) if the file is not a PNG.
 std::pair<std::uint32_t, std::uint32_t> pngSize(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -65,7 +59,7 @@ void runQuickStudy(const std::string& study, const fs::path& out, const std::str
     EXPECT_EQ(pngSize(entry.path()), (std::pair<std::uint32_t, std::uint32_t>{900, 560})) << entry.path();
   }
   EXPECT_EQ(charts, 2);
-  EXPECT_NE(readText(out / "report.md").find(fmt::format("# Study `{}` (quick)", study)), std::string::npos);
+  EXPECT_NE(fct::test::readText(out / "report.md").find(fmt::format("# Study `{}` (quick)", study)), std::string::npos);
 }
 
 /// Sets FLUOROCT_DATA_DIR (or unsets it, for nullopt) for the CLI runs of its lifetime, then restores it.
@@ -104,17 +98,17 @@ const std::string kQuickTable2Setup =
 TEST(EvaluateCommand, QuickTable2WritesTrialsChartsAndTheTableBesideThePaper) {
   const auto out = fct::test::scratchDir() / "table2";
   runQuickStudy("table2", out);
-  const std::string csv = readText(out / "trials.csv");
+  const std::string csv = fct::test::readText(out / "trials.csv");
   EXPECT_EQ(csv.rfind("study,ct,condition,scenario,variant,views,trial,seed,initial_target_mm,initial_stre_mm,"
                       "stre_mean_mm,stre_max_mm,mtre_mm,rotation_deg,translation_mm,success,seconds,setup_seconds,drrs,status,"
                       "reason\n",
                       0),
             0u);
-  const std::string report = readText(out / "report.md");
+  const std::string report = fct::test::readText(out / "report.md");
   EXPECT_NE(report.find("| phantom | realistic | 2.4 mm | 2 |"), std::string::npos) << report;
   EXPECT_NE(report.find("| phantom | ideal | 2 mm (original) | 2 |"), std::string::npos) << report;
   EXPECT_NE(report.find("DRR method `siddon`; detector 128x128 px at 2.4 mm"), std::string::npos) << report;
-  EXPECT_NE(readText(out / "setup.txt").find("detector: 128x128\npixel_mm: 2.4\n"), std::string::npos);
+  EXPECT_NE(fct::test::readText(out / "setup.txt").find("detector: 128x128\npixel_mm: 2.4\n"), std::string::npos);
   EXPECT_NE(report.find("paper mean sTRE"), std::string::npos);
   EXPECT_NE(report.find("![Success rate by scenario](table2_success.png)"), std::string::npos);
 }
@@ -124,7 +118,7 @@ TEST(EvaluateCommand, QuickCaptureStudyRuns) { runQuickStudy("capture", fct::tes
 TEST(EvaluateCommand, QuickAblationWithTransgraphHasANoTransgraphRow) {
   const auto out = fct::test::scratchDir() / "ablation";
   runQuickStudy("ablation", out, "--method transgraph", fct::DrrMethod::Transgraph);
-  const std::string report = readText(out / "report.md");
+  const std::string report = fct::test::readText(out / "report.md");
   EXPECT_NE(report.find("| phantom | no-transgraph | 2 |"), std::string::npos) << report;
   EXPECT_EQ(report.find("Transgraph off: no row"), std::string::npos) << report;
   EXPECT_NE(report.find("DRR method `transgraph`"), std::string::npos) << report;
@@ -203,8 +197,8 @@ TEST(EvaluateCommand, ResumeWithOtherOptionsIsRefused) {
       fmt::format("evaluate --study table2 --quick --method transgraph --out '{}'", out.string()));
   EXPECT_EQ(method.exitCode, 2);
   EXPECT_NE(method.err.find("'method: transgraph' now, 'method: siddon' stored"), std::string::npos) << method.err;
-  EXPECT_EQ(readText(out / "trials.csv"), csv);  // nothing ran, nothing rewritten
-  EXPECT_EQ(readText(out / "setup.txt"), kQuickTable2Setup);
+  EXPECT_EQ(fct::test::readText(out / "trials.csv"), csv);  // nothing ran, nothing rewritten
+  EXPECT_EQ(fct::test::readText(out / "setup.txt"), kQuickTable2Setup);
 }
 
 TEST(EvaluateCommand, BadOptionsAreRefusedBeforeAnythingIsWritten) {

@@ -18,12 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string readText(const fs::path& path) {
-  auto text = fct::TextFile::read(path);
-  EXPECT_TRUE(text.ok()) << text.error();
-  return text.ok() ? text.value() : std::string();
-}
-
 /// The trials of DIR/trials.csv as CSV text with the two time columns zeroed (all that may differ between runs).
 std::string trialsWithoutTimes(const fs::path& dir) {
   auto store = fct::TrialStore::open(dir / "trials.csv");
@@ -37,7 +31,7 @@ std::string trialsWithoutTimes(const fs::path& dir) {
 /// DIR/report.md without what may differ between runs of the same trials: the "written" date line, the output folder
 /// (`out` is replaced by OUT) and the cells of the time columns of every table.
 std::string reportWithoutTimes(const fs::path& dir) {
-  std::string text = readText(dir / "report.md");
+  std::string text = fct::test::readText(dir / "report.md");
   for (std::size_t at; (at = text.find(dir.string())) != std::string::npos;) text.replace(at, dir.string().size(), "OUT");
   std::istringstream lines(text);
   std::string out;
@@ -67,8 +61,8 @@ std::string reportWithoutTimes(const fs::path& dir) {
 void expectSameStudy(const fs::path& merged, const fs::path& single, const std::vector<std::string>& charts) {
   EXPECT_EQ(trialsWithoutTimes(merged), trialsWithoutTimes(single));
   EXPECT_EQ(reportWithoutTimes(merged), reportWithoutTimes(single));
-  EXPECT_EQ(readText(merged / "setup.txt"), readText(single / "setup.txt"));
-  for (const std::string& chart : charts) EXPECT_EQ(readText(merged / chart), readText(single / chart)) << chart;
+  EXPECT_EQ(fct::test::readText(merged / "setup.txt"), fct::test::readText(single / "setup.txt"));
+  for (const std::string& chart : charts) EXPECT_EQ(fct::test::readText(merged / chart), fct::test::readText(single / chart)) << chart;
 }
 
 /// The options of a quick views study small enough for a unit test: one trial per view count, a 64x64 detector.
@@ -84,7 +78,7 @@ TEST(EvaluateCommand, ShardsOfAQuickStudyMergeIntoTheTrialsOfOneRun) {
     ASSERT_EQ(shard.exitCode, 0) << shard.err;
     EXPECT_NE(shard.out.find(fmt::format("views shard {}/2: ran {} trials", k, k == 1 ? 2 : 1)), std::string::npos)
         << shard.out;
-    EXPECT_NE(readText(dir / std::to_string(k) / "setup.txt").find(fmt::format("\nshard: {}/2 of 3 trials\n", k)), std::string::npos);
+    EXPECT_NE(fct::test::readText(dir / std::to_string(k) / "setup.txt").find(fmt::format("\nshard: {}/2 of 3 trials\n", k)), std::string::npos);
   }
   const auto merge = fct::test::runCli(fmt::format("evaluate {} --merge '{}' '{}' --out '{}'", kTinyViews,
                                                    (dir / "1").string(), (dir / "2").string(), (dir / "merged").string()));

@@ -13,15 +13,6 @@
 
 namespace {
 
-/// A fresh folder for this test's files (runCli() wipes scratchDir() on each call, so the files live beside it).
-std::filesystem::path workDir() {
-  const auto dir = fct::test::scratchDir().parent_path() /
-                   (std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_files");
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
 /// Writes a small phantom, a 3-view file with a small detector and a pose into `dir`.
 void makeInputs(const std::filesystem::path& dir) {
   ASSERT_EQ(fct::test::runCli(fmt::format("phantom --out '{}' --dims 40 40 30 --spacing-mm 4", (dir / "ct.nrrd").string()))
@@ -59,7 +50,7 @@ std::string simulateCommand(const std::filesystem::path& dir, const std::filesys
 }  // namespace
 
 TEST(ViewsCommand, WritesStandardViewsAroundTheCtCentre) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   makeInputs(dir);
   auto views = fct::ViewFile::read(dir / "views.json");
   ASSERT_TRUE(views.ok()) << views.error();
@@ -74,7 +65,7 @@ TEST(ViewsCommand, WritesStandardViewsAroundTheCtCentre) {
 }
 
 TEST(ViewsCommand, ImagesOptionNamesOneImagePerView) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   makeInputs(dir);
   const auto run = fct::test::runCli(fmt::format("views --ct '{}' --out '{}' --count 2 --images '{}'",
                                                  (dir / "ct.nrrd").string(), (dir / "named.json").string(),
@@ -86,7 +77,7 @@ TEST(ViewsCommand, ImagesOptionNamesOneImagePerView) {
 }
 
 TEST(SimulateCommand, WritesARegistrationCase) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   makeInputs(dir);
   const auto out = dir / "case";
   const auto run = fct::test::runCli(fmt::format(
@@ -116,7 +107,7 @@ TEST(SimulateCommand, WritesARegistrationCase) {
 }
 
 TEST(SimulateCommand, FailsCleanlyOnBadInputs) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   makeInputs(dir);
   const auto out = dir / "case";
   const std::string base = simulateCommand(dir, out);
@@ -149,7 +140,7 @@ TEST(SimulateCommand, FailsCleanlyOnBadInputs) {
 }
 
 TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegradedCt) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   makeInputs(dir);
   const auto out = dir / "physical";
   const auto run = fct::test::runCli(fmt::format(
@@ -184,7 +175,7 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
 }
 
 TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   makeInputs(dir);
   const auto out = dir / "case";
   const std::string base = simulateCommand(dir, out);
@@ -205,7 +196,7 @@ TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
 }
 
 TEST(SimulateCommand, GasPocketsWithoutSoftTissueNameTheOption) {
-  const auto dir = workDir();
+  const auto dir = fct::test::workDir();
   // Solid bone: no soft tissue anywhere for a gas pocket.
   const auto bone = fct::Volume::create(Eigen::Vector3i(20, 20, 20), Eigen::Vector3d::Constant(4.0),
                                         Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 1000.0f);

@@ -61,8 +61,6 @@ std::vector<fs::path> threeShards(const fs::path& root, const fct::StudyDefiniti
   return folders;
 }
 
-std::string readText(const fs::path& path) { return fct::TextFile::read(path).value(); }
-
 }  // namespace
 
 TEST(StudyMerge, ShardFoldersMergeInStudyOrderIntoAFolderThatReadsLikeOneRun) {
@@ -87,8 +85,8 @@ TEST(StudyMerge, ShardFoldersMergeInStudyOrderIntoAFolderThatReadsLikeOneRun) {
   fs::create_directories(out);
   const fct::Status written = fct::StudyMerge::write(out, setup, merged.value());
   ASSERT_TRUE(written.ok()) << written.error();
-  EXPECT_EQ(readText(out / "trials.csv"), fct::TrialStore::toCsv(expected));
-  EXPECT_EQ(readText(out / "setup.txt"), setup);
+  EXPECT_EQ(fct::test::readText(out / "trials.csv"), fct::TrialStore::toCsv(expected));
+  EXPECT_EQ(fct::test::readText(out / "setup.txt"), setup);
   const fct::Status again = fct::StudyMerge::write(out, setup, merged.value());
   EXPECT_TRUE(again.ok()) << "a merge may be repeated into its own folder: " << again.error();
 }
@@ -175,6 +173,6 @@ TEST(StudyMerge, AFolderWhoseFinishedTrialsTheMergeWouldReplaceIsLeftAsItIs) {
   fct::StudyDefinition other = study;
   other.setup.seed = 7;
   EXPECT_FALSE(fct::StudyMerge::write(out, fct::StudySetupFile::text(other, {}), {mine}).ok());
-  EXPECT_EQ(readText(out / "trials.csv"), csv);
-  EXPECT_EQ(readText(out / "setup.txt"), setup);
+  EXPECT_EQ(fct::test::readText(out / "trials.csv"), csv);
+  EXPECT_EQ(fct::test::readText(out / "setup.txt"), setup);
 }

@@ -18,8 +18,6 @@ fct::StudyDefinition quickTable2() {
   return fct::StudyCatalog::define("table2", true, {"phantom"}, fct::DrrMethod::Siddon).value();
 }
 
-std::string readText(const fs::path& path) { return fct::TextFile::read(path).value(); }
-
 }  // namespace
 
 TEST(StudySetupFile, TextSpellsOutEveryOptionThatChangesResults) {
@@ -47,10 +45,10 @@ TEST(StudySetupFile, FirstRunWritesTheFileAndAResumeWithTheSameOptionsIsAccepted
   const std::string text = StudySetupFile::text(quickTable2(), {});
   const fct::Status first = StudySetupFile::checkOrWrite(dir, text, false);
   ASSERT_TRUE(first.ok()) << first.error();
-  EXPECT_EQ(readText(dir / "setup.txt"), text);
+  EXPECT_EQ(fct::test::readText(dir / "setup.txt"), text);
   const fct::Status resume = StudySetupFile::checkOrWrite(dir, text, true);
   EXPECT_TRUE(resume.ok()) << resume.error();
-  EXPECT_EQ(readText(dir / "setup.txt"), text);
+  EXPECT_EQ(fct::test::readText(dir / "setup.txt"), text);
 }
 
 TEST(StudySetupFile, AResumeWithOtherOptionsIsRefusedNamingEachDifference) {
@@ -66,7 +64,7 @@ TEST(StudySetupFile, AResumeWithOtherOptionsIsRefusedNamingEachDifference) {
                                               "'detector: 128x128' stored; 'seed: 5' now, 'seed: 1' stored)"),
             std::string::npos)
       << other.error();
-  EXPECT_EQ(readText(dir / "setup.txt"), stored) << "nothing written";
+  EXPECT_EQ(fct::test::readText(dir / "setup.txt"), stored) << "nothing written";
 
   const fct::Status shorter = StudySetupFile::checkOrWrite(dir, "study: table2\n", true);
   ASSERT_FALSE(shorter.ok());
