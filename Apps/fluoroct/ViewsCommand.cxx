@@ -1,6 +1,7 @@
 // fluoroct views: writes a view file, either of standard C-arm views (AP, lateral, obliques) around a CT's centre, or
 // of one view per X-ray DICOM file from its C-arm geometry tags (--from-dicom).
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <memory>
 #include <string>
@@ -67,11 +68,14 @@ int writeDicomViews(const Options& o) {
   const std::vector<std::filesystem::path> files(o.fromDicom.begin(), o.fromDicom.end());
   auto views = DicomViewBuilder::build(files, options);
   if (!views.ok()) {
-    std::string hint;
-    if (views.error().find("missing") != std::string::npos) {
-      hint = "; or give the missing values with --sid-mm (source to detector), --sod-mm (source to isocentre) or "
-             "--pixel-spacing-mm (detector pixel size)";
+    // The message names the view-file key of each missing value; offer the flag that supplies just those.
+    std::vector<std::string> flags;
+    for (const auto& [key, flag] : {std::pair{"source_to_detector_mm", "--sid-mm (source to detector)"},
+                                    std::pair{"source_to_patient_mm", "--sod-mm (source to isocentre)"},
+                                    std::pair{"detector.pixel_spacing_mm", "--pixel-spacing-mm (detector pixel size)"}}) {
+      if (views.error().find(key) != std::string::npos) flags.emplace_back(flag);
     }
+    const std::string hint = flags.empty() ? "" : fmt::format("; or give {}", fmt::join(flags, " and "));
     return reportError(views.error() + hint);
   }
   printWarnings(views.warnings());

@@ -12,8 +12,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "Evaluation/StudyRunner.h"
 #include "Evaluation/StudyXraySource.h"
-#include "Geometry/RigidPose.h"
 #include "Image/BoneSurface.h"
 #include "Registration/Registration.h"
 #include "Registration/RegistrationCase.h"
@@ -67,11 +67,7 @@ double errorFromTruth(const fct::Volume& registrationCt, const std::vector<fct::
 
 TEST(CrimeFreeEvaluation, DISABLED_StartAtTruthStaysAndAHalfVoxelShiftChangesNothing) {
   const fct::Volume ct = phantom();
-  const Eigen::Vector3d centre = fct::BoneSurface::extract(ct).value().centroid_ct_mm();
-  fct::PoseParameters truth;
-  truth.rotation_deg = Eigen::Vector3d(4.0, -3.0, 6.0);
-  truth.translation_mm = -centre + Eigen::Vector3d(2.0, -3.0, 1.5);
-  const Eigen::Isometry3d T_truth = fct::RigidPose::toTransform(truth, centre);
+  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(fct::BoneSurface::extract(ct).value());
   fct::StandardViewOptions viewOptions;
   viewOptions.count = 3;
   viewOptions.cols = viewOptions.rows = 128;

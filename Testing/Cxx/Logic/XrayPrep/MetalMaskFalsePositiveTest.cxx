@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "Geometry/RigidPose.h"
+#include "Evaluation/StudyRunner.h"
 #include "IO/Volume/CtLoader.h"
 #include "Image/BoneSurface.h"
 #include "Simulation/FluoroscopySimulator.h"
@@ -27,11 +27,7 @@ namespace {
 /// Largest fraction of valid pixels the metal mask (threshold minExcess) removes over the views of `ct` simulated with
 /// `kwires` K-wires and `screws` screws; prints each view's fraction.
 double largestMetalFraction(const fct::Volume& ct, int kwires, int screws, double minExcess) {
-  const Eigen::Vector3d centre = fct::BoneSurface::extract(ct).value().centroid_ct_mm();
-  fct::PoseParameters truth;
-  truth.rotation_deg = Eigen::Vector3d(4.0, -3.0, 6.0);
-  truth.translation_mm = -centre + Eigen::Vector3d(2.0, -3.0, 1.5);
-  const Eigen::Isometry3d T_truth = fct::RigidPose::toTransform(truth, centre);
+  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(fct::BoneSurface::extract(ct).value());
   fct::StandardViewOptions viewOptions;
   viewOptions.count = 5;
   viewOptions.cols = 192;
