@@ -1,6 +1,5 @@
 #include "Widgets/RegisterStepWidget.h"
 
-#include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
@@ -99,14 +98,21 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   }
   for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged}) {
     connect(m_document, signal, this, [this] {
-      if (m_thread) m_inputsChangedDuringRun = true;
+      if (isRunning()) m_inputsChangedDuringRun = true;
     });
   }
+  connect(m_document, &StudioDocument::casePreparationFinished, this, &RegisterStepWidget::onCasePrepared);
+  connect(m_document, &StudioDocument::casePreparationProgressed, this, [this](const QString& step, double fraction) {
+    if (!m_pending) return;
+    m_progressBar->setValue(0);
+    m_progressLabel->setText(tr("Preparing the case: %1 (%2 %)…").arg(step).arg(100.0 * fraction, 0, 'f', 0));
+  });
   syncControls();
   updateRunButton();
 }
 
 RegisterStepWidget::~RegisterStepWidget() {
+  if (m_pending) m_document->cancelCasePreparation();
   if (m_worker) m_worker->cancel();
   endThread();
 }
@@ -114,7 +120,7 @@ RegisterStepWidget::~RegisterStepWidget() {
 void RegisterStepWidget::attachViews(std::vector<XrayViewWidget*>, std::array<SliceViewWidget*, 3>) {}
 
 void RegisterStepWidget::setActive(bool active) {
-  if (!active || m_thread) return;
+  if (!active || isRunning()) return;
   const RoiParameters& roi = m_document->roiParameters();
   if (!m_document->initialPose()) {
     showMessage(tr("No initial pose yet: set one in the Initial pose step (landmarks or the supine AP preset)."), true);
@@ -165,7 +171,7 @@ QString RegisterStepWidget::missingInputs() const {
 
 void RegisterStepWidget::updateRunButton() {
   const QString missing = missingInputs();
-  m_runButton->setEnabled(!m_thread && missing.isEmpty());
+  m_runButton->setEnabled(!isRunning() && missing.isEmpty());
   m_runButton->setToolTip(missing.isEmpty() ? tr("Register the CT to the X-rays from the initial pose")
                                             : tr("Run needs %1").arg(missing));
 }
@@ -197,7 +203,7 @@ void RegisterStepWidget::logStages(const RegistrationResult& result) {
 
 void RegisterStepWidget::showDocumentResult() {
   const RegistrationResult* result = m_document->result();
-  if (m_thread || (m_ranHere && result)) return;
+  if (isRunning() || (m_ranHere && result)) return;
   m_ranHere = false;
   m_log->clear();
   if (!result) {
@@ -248,7 +254,7 @@ void RegisterStepWidget::pushOptions() {
 }
 
 bool RegisterStepWidget::run() {
-  if (m_thread) {
+  if (isRunning()) {
     showMessage(tr("A registration is already running; cancel it first."), true);
     return false;
   }
@@ -269,14 +275,6 @@ bool RegisterStepWidget::run() {
     showMessage(tr("ROI settings: %1; fix them in the ROIs step.").arg(QString::fromStdString(tuned.error())), true);
     return false;
   }
-  showMessage(tr("Preparing the case…"), false);
-  QApplication::setOverrideCursor(Qt::WaitCursor);
-  auto prepared = m_document->preparedCase();
-  QApplication::restoreOverrideCursor();
-  if (!prepared) {
-    showMessage(tr("Cannot register: %1").arg(QString::fromStdString(prepared.error())), true);
-    return false;
-  }
   RegistrationOptions options;
   options.schedule = std::move(tuned).value();
   options.ablation = ablation();
@@ -292,22 +290,64 @@ bool RegisterStepWidget::run() {
   m_lastProgress = RegistrationProgress{};
   m_inputsChangedDuringRun = false;
   m_ranHere = true;
+  m_pending = Pending{*initial, std::move(options)};
+  setRunningUi(true);
+  emit runningChanged(true);
+  if (m_document->readyCase()) {
+    startRegistration();
+  } else {
+    // The case is prepared on a worker thread first (seconds for a large CT); casePreparationFinished starts the run.
+    m_progressBar->setValue(0);
+    m_progressLabel->setText(tr("Preparing the case…"));
+    showMessage(tr("Preparing the case (the CT for DRRs and the X-rays), then registering…"), false);
+    m_document->prepareCaseInBackground();
+  }
+  return true;
+}
+
+void RegisterStepWidget::onCasePrepared(bool prepared, const QString& why) {
+  if (!m_pending || m_thread) return;
+  if (!prepared && (m_document->isPreparingCase() || m_document->readyCase())) return;  // a newer one is under way
+  if (prepared) {
+    startRegistration();
+    return;
+  }
+  m_pending.reset();
+  const QString text = m_inputsChangedDuringRun
+                           ? tr("The CT or the views changed during the run, so it stopped before registering; run "
+                                "again.")
+                           : tr("Cannot register: %1").arg(why);
+  appendLog(text);
+  showMessage(text, !m_cancelRequested);
+  m_progressLabel->setText(tr("Not started"));
+  m_cancelRequested = false;
+  setRunningUi(false);
+  emit runningChanged(false);
+}
+
+void RegisterStepWidget::startRegistration() {
   m_runTimer.start();
-  m_worker = new RegistrationWorker(prepared.value(), *initial, std::move(options));
+  m_worker = new RegistrationWorker(m_document->readyCase(), m_pending->T_initial, std::move(m_pending->options));
+  m_pending.reset();
   m_thread = new QThread(this);
   m_worker->moveToThread(m_thread);
   connect(m_thread, &QThread::started, m_worker, &RegistrationWorker::run);
   connect(m_worker, &RegistrationWorker::progressed, this, &RegisterStepWidget::onProgress);
   connect(m_worker, &RegistrationWorker::finished, this, &RegisterStepWidget::onFinished);
   connect(m_worker, &RegistrationWorker::failed, this, &RegisterStepWidget::onFailed);
-  setRunningUi(true);
+  if (m_cancelRequested) m_worker->cancel();
   showMessage(tr("Registering…"), false);
   m_thread->start();
-  emit runningChanged(true);
-  return true;
 }
 
 void RegisterStepWidget::cancel() {
+  if (m_pending) {
+    m_cancelRequested = true;
+    m_document->cancelCasePreparation();
+    m_cancelButton->setEnabled(false);
+    showMessage(tr("Cancelling: the case preparation stops at its next step; nothing is registered."), false);
+    return;
+  }
   if (!m_worker) return;
   m_worker->cancel();
   m_cancelButton->setEnabled(false);
@@ -386,6 +426,7 @@ void RegisterStepWidget::endThread() {
 
 void RegisterStepWidget::setRunningUi(bool running) {
   m_cancelButton->setEnabled(running);
+  if (!running) m_cancelRequested = false;
   for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
                                                           m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
                                                           m_cmaesCheck, m_noTransgraphCheck, m_noCtPyramidCheck}) {

@@ -12,6 +12,7 @@
 #include <QWidget>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "Registration/Registration.h"
@@ -46,8 +47,8 @@ class RegisterStepWidget : public QWidget {
   /// Activating shows whether the step is ready (initial pose, ROI settings); a started run goes on either way.
   void setActive(bool active);
 
-  /// True while a registration runs.
-  bool isRunning() const { return m_thread != nullptr; }
+  /// True while a run prepares its case or registers.
+  bool isRunning() const { return m_thread != nullptr || m_pending.has_value(); }
   /// The ablation switches in effect.
   RegistrationAblation ablation() const;
   /// Sets the ablation switches' check boxes.
@@ -83,6 +84,10 @@ class RegisterStepWidget : public QWidget {
   void statusMessage(const QString& message);
 
  private:
+  /// The document's background case preparation ended: starts the pending run, or ends it with the reason.
+  void onCasePrepared(bool prepared, const QString& why);
+  /// Starts the pending run on the document's ready case, on a worker thread.
+  void startRegistration();
   void onProgress(const RegistrationProgress& progress);
   void onFinished(const RegistrationResult& result);
   void onFailed(const QString& message);
@@ -108,6 +113,13 @@ class RegisterStepWidget : public QWidget {
   QThread* m_thread = nullptr;
   RegistrationWorker* m_worker = nullptr;
   RegistrationProgress m_lastProgress;
+  /// A run waiting for its case: its start pose and options.
+  struct Pending {
+    Eigen::Isometry3d T_initial;
+    RegistrationOptions options;
+  };
+  std::optional<Pending> m_pending;
+  bool m_cancelRequested = false;         ///< Cancel was pressed while the case was prepared
   bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
   bool m_ranHere = false;                 ///< a run of this widget is shown (not a result from the session)
   QElapsedTimer m_runTimer;               ///< since the current run started (for the time left)

@@ -241,6 +241,9 @@ ReviewStepWidget::ReviewStepWidget(StudioDocument* document, QWidget* parent)
       if (m_active && reviewedPoses() != m_shownPoses) refresh();
     });
   }
+  connect(m_document, &StudioDocument::casePreparationFinished, this, [this](bool prepared) {
+    if (m_active && prepared && m_shownPoses.second && m_drrGrey.empty()) refresh();
+  });
   connect(m_document, &StudioDocument::resultChanged, this, &ReviewStepWidget::updateVerdict);
   updateVerdict();
 }
@@ -337,20 +340,19 @@ void ReviewStepWidget::refresh() {
       }
     }
   }
-  if (final) {
-    auto prepared = m_document->preparedCase();
-    if (prepared) {
-      for (std::size_t v = 0; v < views.size(); ++v) {
-        auto drr = prepared.value()->renderer().render(views[v].camera, *final, 0);
-        if (drr) {
-          m_drrGrey.push_back(greyDrr(drr.value()));
-        } else {
-          m_drrGrey.emplace_back();
-          problems << QString::fromStdString(views[v].name + ": " + drr.error());
-        }
+  if (final && !m_document->readyCase()) {
+    // The DRR needs the prepared case: it is made on a worker thread and casePreparationFinished redraws.
+    m_document->prepareCaseInBackground();
+  } else if (final) {
+    const DrrRenderer& renderer = m_document->readyCase()->renderer();
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      auto drr = renderer.render(views[v].camera, *final, 0);
+      if (drr) {
+        m_drrGrey.push_back(greyDrr(drr.value()));
+      } else {
+        m_drrGrey.emplace_back();
+        problems << QString::fromStdString(views[v].name + ": " + drr.error());
       }
-    } else {
-      problems << QString::fromStdString(prepared.error());
     }
   }
   QApplication::restoreOverrideCursor();

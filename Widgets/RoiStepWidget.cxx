@@ -1,6 +1,5 @@
 #include "Widgets/RoiStepWidget.h"
 
-#include <QApplication>
 #include <QButtonGroup>
 #include <QCheckBox>
 #include <QComboBox>
@@ -80,8 +79,9 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
   m_thresholdSlider = new QSlider(Qt::Horizontal, roiBox);
   m_thresholdSlider->setRange(0, (kMaxThresholdExponent - kMinThresholdExponent) * kThresholdSliderSteps);
   m_thresholdSpin = new QDoubleSpinBox(roiBox);
-  m_thresholdSpin->setRange(0.0, std::pow(10.0, kMaxThresholdExponent));
-  m_thresholdSpin->setDecimals(6);
+  // The spin box covers the slider's range, with the decimals its low end needs (10^-4 reads "0.0001", not "0.000").
+  m_thresholdSpin->setRange(std::pow(10.0, kMinThresholdExponent), std::pow(10.0, kMaxThresholdExponent));
+  m_thresholdSpin->setDecimals(-kMinThresholdExponent);
   m_thresholdSpin->setStepType(QAbstractSpinBox::AdaptiveDecimalStepType);
   m_thresholdSpin->setToolTip(tr("Keep windows whose variance is at least this multiple of the image's variance"));
   form->addRow(m_thresholdRadio, sliderRow(m_thresholdSlider, m_thresholdSpin, roiBox));
@@ -174,6 +174,18 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
     m_case.reset();
     updateSelection();
   };
+  connect(m_document, &StudioDocument::casePreparationProgressed, this, [this](const QString& step, double fraction) {
+    if (m_active) showMessage(tr("Preparing the case for the ROIs: %1 (%2 %)…").arg(step).arg(100.0 * fraction, 0, 'f', 0), false);
+  });
+  connect(m_document, &StudioDocument::casePreparationFinished, this, [this](bool prepared, const QString& why) {
+    if (!m_active) return;
+    if (prepared) {
+      showMessage(QString(), false);
+      updateSelection();
+    } else if (!m_document->isPreparingCase() && !m_document->readyCase()) {
+      showMessage(tr("No ROIs to show: %1").arg(why), true);
+    }
+  });
   connect(m_document, &StudioDocument::ctChanged, this, dropCase);
   connect(m_document, &StudioDocument::viewsChanged, this, dropCase);
   syncControls();
@@ -256,18 +268,22 @@ void RoiStepWidget::pushParameters() {
 }
 
 bool RoiStepWidget::ensureSelectors() {
-  QApplication::setOverrideCursor(Qt::WaitCursor);  // the first call prepares the case (seconds for a large CT)
-  auto prepared = m_document->preparedCase();
-  QApplication::restoreOverrideCursor();
+  const std::shared_ptr<RegistrationCase>& prepared = m_document->readyCase();
   if (!prepared) {
+    // The case is prepared on a worker thread (seconds for a large CT); casePreparationFinished brings the ROIs.
     m_case.reset();
     m_selectors.clear();
-    showMessage(tr("No ROIs to show: %1").arg(QString::fromStdString(prepared.error())), true);
+    if (!m_document->ct() || m_document->views().empty()) {
+      showMessage(tr("No ROIs to show: open a CT and X-ray views in the Data step."), true);
+    } else {
+      if (!m_document->isPreparingCase()) showMessage(tr("Preparing the case for the ROIs…"), false);
+      m_document->prepareCaseInBackground();
+    }
     return false;
   }
   const int window = m_document->roiParameters().windowSize;
-  if (prepared.value() != m_case) {
-    m_case = prepared.value();
+  if (prepared != m_case) {
+    m_case = prepared;
     m_selectors.clear();
     m_exclusionsDrawn = false;
   }

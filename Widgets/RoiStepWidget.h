@@ -70,6 +70,8 @@ class RoiStepWidget : public QWidget {
   QString message() const;
   /// The threshold slider (for tests driving it like a user).
   QSlider* thresholdSlider() const { return m_thresholdSlider; }
+  /// The threshold spin box beside the slider.
+  QDoubleSpinBox* thresholdSpin() const { return m_thresholdSpin; }
   /// The fraction slider.
   QSlider* fractionSlider() const { return m_fractionSlider; }
 

@@ -2,11 +2,14 @@
 
 #include <fmt/core.h>
 
+#include <QMetaObject>
+
 #include <algorithm>
 #include <set>
 #include <utility>
 
 #include "Drr/DrrRendererFactory.h"
+#include "Widgets/CasePreparation.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/XrayLoader.h"
@@ -259,8 +262,7 @@ XrayPreparationOptions StudioDocument::preparationOptions() const {
   return preparation;
 }
 
-Result<std::shared_ptr<RegistrationCase>> StudioDocument::preparedCase() {
-  if (m_case) return m_case;
+Result<RegistrationCaseOptions> StudioDocument::caseOptions() const {
   if (!m_ct) return fail("no CT loaded; open a CT in the Data step first");
   if (m_views.empty()) return fail("no X-ray views loaded; open a view file in the Data step first");
   auto method = DrrRendererFactory::parseMethod(m_options.drrMethod);
@@ -268,12 +270,70 @@ Result<std::shared_ptr<RegistrationCase>> StudioDocument::preparedCase() {
   RegistrationCaseOptions options;
   options.drr.method = method.value();
   options.preparation = preparationOptions();
-  auto created = RegistrationCase::create(*m_ct, m_views, options);
+  return options;
+}
+
+Result<std::shared_ptr<RegistrationCase>> StudioDocument::preparedCase() {
+  if (m_case) return m_case;
+  if (m_preparation) {
+    const Status adopted = adoptPreparation();
+    if (!adopted) return fail(adopted.error());
+    return m_case;
+  }
+  auto options = caseOptions();
+  if (!options) return fail(options.error());
+  auto created = RegistrationCase::create(*m_ct, m_views, options.value());
   if (!created) return fail(created.error());
   Result<std::shared_ptr<RegistrationCase>> prepared(std::make_shared<RegistrationCase>(std::move(created).value()));
   for (const std::string& warning : created.warnings()) prepared.addWarning(warning);
   m_case = prepared.value();
+  emit casePreparationFinished(true, QString());
   return prepared;
+}
+
+void StudioDocument::prepareCaseInBackground() {
+  if (m_case || m_preparation) return;
+  auto options = caseOptions();
+  if (!options) {
+    const QString why = QString::fromStdString(options.error());
+    QMetaObject::invokeMethod(this, [this, why] { emit casePreparationFinished(false, why); }, Qt::QueuedConnection);
+    return;
+  }
+  m_preparation = new CasePreparation(m_ct, m_views, options.value(), this);
+  connect(m_preparation, &CasePreparation::progressed, this, &StudioDocument::casePreparationProgressed);
+  connect(m_preparation, &CasePreparation::finished, this, [this] {
+    if (m_preparation) adoptPreparation();
+  });
+}
+
+void StudioDocument::cancelCasePreparation() {
+  if (m_preparation) m_preparation->cancel();
+}
+
+Status StudioDocument::adoptPreparation() {
+  CasePreparation::Outcome outcome = m_preparation->wait();
+  m_preparation->deleteLater();
+  m_preparation = nullptr;
+  if (!outcome.prepared) {
+    emit casePreparationFinished(false, QString::fromStdString(outcome.error));
+    return fail(outcome.error);
+  }
+  m_case = std::move(outcome.prepared);
+  emit casePreparationFinished(true, QString());
+  return Ok{};
+}
+
+void StudioDocument::invalidateCase() {
+  m_case.reset();
+  if (!m_preparation) return;
+  // The old inputs' preparation goes on to its next step, then deletes itself; its case is never used.
+  CasePreparation* stale = m_preparation;
+  m_preparation = nullptr;
+  stale->disconnect(this);
+  stale->cancel();
+  connect(stale, &CasePreparation::finished, stale, &QObject::deleteLater);
+  const QString why = tr("the CT, the views, the exclusions or the DRR method changed while the case was prepared");
+  QMetaObject::invokeMethod(this, [this, why] { emit casePreparationFinished(false, why); }, Qt::QueuedConnection);
 }
 
 const RegistrationResult* StudioDocument::result() const {

@@ -28,6 +28,8 @@
 
 namespace fct {
 
+class CasePreparation;
+
 /// How the dynamic ROIs are chosen and which pixels are excluded (full-resolution pixels unless said otherwise).
 struct RoiParameters {
   int windowSize = 7;               ///< w of the w x w windows, pixels of the level they are chosen on
@@ -170,10 +172,21 @@ class StudioDocument : public QObject {
   /// The XrayPreparation options of the ROI parameters' exclusions (view spheres are added per view by the case).
   XrayPreparationOptions preparationOptions() const;
   /// The registration case of the current CT, views, exclusions and DRR method, prepared on first call and kept
-  /// until one of those changes. Slow on first call (seconds for a large CT). Shared with whoever runs on it: do not
-  /// call while a registration runs on another thread. Fails when the CT or the views are missing, or as
+  /// until one of those changes. Slow on first call (seconds for a large CT; the widgets use
+  /// prepareCaseInBackground() instead); joins a background preparation under way. Shared with whoever runs on it:
+  /// do not call while a registration runs on another thread. Fails when the CT or the views are missing, or as
   /// RegistrationCase::create.
   Result<std::shared_ptr<RegistrationCase>> preparedCase();
+  /// The prepared case when it is ready, else null (nothing is started).
+  const std::shared_ptr<RegistrationCase>& readyCase() const { return m_case; }
+  /// Prepares the case on a worker thread unless it is ready or under way: casePreparationProgressed() follows it,
+  /// casePreparationFinished() ends it (queued, also when it cannot start: no CT, no views, an unknown DRR method).
+  /// A change of the CT, the views, the exclusions or the DRR method meanwhile drops it (finished with an error).
+  void prepareCaseInBackground();
+  /// True while a background preparation is under way.
+  bool isPreparingCase() const { return m_preparation != nullptr; }
+  /// Stops a background preparation at its next step (it finishes with a "cancelled" error); no effect when none.
+  void cancelCasePreparation();
 
   // --- Results and ground truth -----------------------------------------------------------------------------------
   /// Every registration result of the session with its verdict, oldest first.
@@ -248,12 +261,21 @@ class StudioDocument : public QObject {
   void changed();
   /// The document became modified (true) or saved (false).
   void modifiedChanged(bool modified);
+  /// A background case preparation started a step (in words) and is this far (0..1).
+  void casePreparationProgressed(const QString& step, double fraction);
+  /// The case became ready (prepared true), or a preparation failed, was cancelled or dropped (the message says why).
+  void casePreparationFinished(bool prepared, const QString& message);
 
  private:
   /// Marks modified and emits changed().
   void touch();
-  /// Drops the prepared case.
-  void invalidateCase() { m_case.reset(); }
+  /// Drops the prepared case, and a background preparation of the old inputs.
+  void invalidateCase();
+  /// The options of the case of the current inputs; fails when the CT or the views are missing or the method is bad.
+  Result<RegistrationCaseOptions> caseOptions() const;
+  /// Takes the outcome of the background preparation (waiting for it), keeps its case and emits
+  /// casePreparationFinished(); fails with its error.
+  Status adoptPreparation();
   /// Drops the initial pose, the results and the ground truth after an input changed, emitting what changed.
   void dropPoseAndResults();
 
@@ -276,6 +298,7 @@ class StudioDocument : public QObject {
   bool m_modified = false;
   std::filesystem::path m_sessionPath;
   std::shared_ptr<RegistrationCase> m_case;
+  CasePreparation* m_preparation = nullptr;  ///< the background preparation of the current inputs (child), or null
 };
 
 }  // namespace fct

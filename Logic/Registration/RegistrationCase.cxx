@@ -28,6 +28,11 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
                                                   const ProgressMonitor& monitor) {
   if (views.empty()) return fail("registration needs at least one X-ray view; the view list is empty");
   RegistrationCase result;
+  // One report per step (the CT, each view, the bone surface); a cancel between steps stops the preparation.
+  const double steps = static_cast<double>(views.size() + 2);
+  const auto cancelled = [&] { return monitor.cancelled(); };
+  const char* const kCancelled = "the case preparation was cancelled";
+  monitor.report("CT", 0.0, "preparing the CT for DRRs");
 
   auto drrVolume = DrrVolume::create(ct);
   if (!drrVolume) return fail("CT: " + drrVolume.error());
@@ -42,7 +47,10 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   }
   result.m_cutFaceMargin_mm = options.cutFaceMargin_mm;
 
-  for (const RegistrationView& view : views) {
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    const RegistrationView& view = views[v];
+    if (cancelled()) return fail(kCancelled);
+    monitor.report("views", static_cast<double>(v + 1) / steps, fmt::format("preparing the X-ray of view '{}'", view.name));
     const CameraIntrinsics& in = view.camera.intrinsics();
     if (in.cols != view.xray.cols || in.rows != view.xray.rows) {
       return fail(fmt::format("view '{}': the camera's detector is {}x{} pixels but the X-ray is {}x{}; fix the view "
@@ -73,6 +81,8 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
     result.m_views.push_back(View{view.name, view.camera, std::move(prepared).value(), {}, result.m_renderer, nullptr});
   }
 
+  if (cancelled()) return fail(kCancelled);
+  monitor.report("bone", static_cast<double>(views.size() + 1) / steps, "extracting the bone surface");
   auto bone = BoneSurface::extract(ct, options.boneThreshold_hu);
   if (bone) {
     result.m_centre_ct_mm = bone.value().centroid_ct_mm();

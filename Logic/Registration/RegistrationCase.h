@@ -56,7 +56,8 @@ struct RegistrationCaseOptions {
 class RegistrationCase {
  public:
   /// Prepares the CT and every view, and for the transgraph method with an expected pose each view's table (the
-  /// monitor sees the builds and can cancel them). Fails, naming the view, on no view, a camera whose detector differs
+  /// monitor gets one report per step, CT, each view, bone surface, and the table builds, and can cancel between
+  /// steps: the error then says the preparation was cancelled). Fails, naming the view, on no view, a camera whose detector differs
   /// from its image, a failed X-ray preparation, an X-ray constant over its valid pixels (nothing to register
   /// against), or a table that cannot be planned or built. A CT without bone above the threshold uses the volume
   /// centre and a quarter of its diagonal (with a warning); Transgraph cache problems are warnings too.

@@ -44,6 +44,7 @@ TEST(ReviewStepWidget, SendToSlicerDeliversTheFinalPoseInRas) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << "the DRR's case, prepared in the background";
   fct::test::IgtlTestReceiver receiver(fct::test::IgtlTestReceiver::Behaviour::Record, 1);
   ASSERT_GT(receiver.port(), 0);
   step.setSlicerAddress(QStringLiteral("127.0.0.1"), receiver.port());
@@ -62,6 +63,7 @@ TEST(ReviewStepWidget, SendToSlicerShowsARefusedConnectionAndAMissingResult) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << "the DRR's case, prepared in the background";
   const int port = fct::test::IgtlTestReceiver::unusedPort();
   ASSERT_GT(port, 0);
   step.setSlicerAddress(QStringLiteral("127.0.0.1"), port);

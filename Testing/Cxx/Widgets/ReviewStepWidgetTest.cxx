@@ -31,6 +31,7 @@ TEST(ReviewStepWidget, DrawsBothOutlinesAndTheDrrAndShowsTheSurfaceError) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document));
   ASSERT_TRUE(step.finalSurfaceTre_mm().has_value()) << step.message().toStdString();
   EXPECT_NEAR(*step.finalSurfaceTre_mm(), 0.0, 1e-9);
   for (fct::XrayViewWidget* view : session.xrayViews) {
@@ -62,6 +63,7 @@ TEST(ReviewStepWidget, AcceptRejectAndExportsReadBack) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document));
   EXPECT_NEAR(*step.finalSurfaceTre_mm(), 0.5, 1e-3);
   step.acceptResult();
   EXPECT_EQ(session.document.resultVerdict(), fct::ResultVerdict::Accepted);
@@ -114,6 +116,7 @@ TEST(ReviewStepWidget, WithoutAResultExportIsRefusedWithAMessage) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document));
   const auto dir = fct::test::scratchDir();
   EXPECT_FALSE(step.exportPose(QString::fromStdString((dir / "pose.tfm").string())));
   EXPECT_NE(step.message().indexOf(QStringLiteral("No registration result")), -1) << step.message().toStdString();
@@ -130,6 +133,7 @@ TEST(ReviewStepWidget, OutlinesAreDrawnOverTheCheckerboardAndTheBlend) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document));
   step.setShowInitial(false);
   step.setContourColours(QColor(255, 0, 255), QColor(255, 0, 255));  // a colour neither the X-ray nor the DRR has
   fct::XrayViewWidget* view = session.xrayViews[0];
@@ -159,6 +163,7 @@ TEST(ReviewStepWidget, TheHistoryKeepsTheAcceptedResultAndGoesBackToAnyRun) {
   fct::ReviewStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document));
   session.document.addResult(resultAt(session, session.T_truth));
   step.acceptResult();
   fct::RegistrationResult later = resultAt(session, session.T_truth);

@@ -2,6 +2,7 @@
 // the kept fraction per view as expected; the overlay layers appear; exclusions are editable.
 #include <gtest/gtest.h>
 
+#include <QDoubleSpinBox>
 #include <QRadioButton>
 #include <QSlider>
 
@@ -31,6 +32,7 @@ TEST(RoiStepWidget, RaisingTheThresholdSliderKeepsFewerPixelsInEveryView) {
   fct::RoiStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
 
   std::vector<double> low(viewCount);
   for (std::size_t v = 0; v < viewCount; ++v) {
@@ -66,11 +68,27 @@ TEST(RoiStepWidget, ThresholdSliderIsLogarithmicAndRoundTrips) {
   EXPECT_EQ(fct::RoiStepWidget::sliderForThreshold(0.0), 0) << "zero and below clamp to the slider's start";
 }
 
+TEST(RoiStepWidget, TheThresholdSpinBoxReadsTheSlidersWholeRangeWithoutZeros) {
+  fct::StudioDocument document;
+  fct::RoiStepWidget step(&document);
+  fct::RoiParameters parameters = document.roiParameters();
+  parameters.useThreshold = true;
+  document.setRoiParameters(parameters);
+  step.thresholdSlider()->setValue(step.thresholdSlider()->minimum());
+  EXPECT_EQ(step.thresholdSpin()->text(), QStringLiteral("0.0001")) << "the low end is not shown as 0.000";
+  EXPECT_DOUBLE_EQ(document.roiParameters().varianceThreshold, 1e-4);
+  step.thresholdSlider()->setValue(step.thresholdSlider()->maximum());
+  EXPECT_DOUBLE_EQ(document.roiParameters().varianceThreshold, 10.0);
+  step.thresholdSpin()->setValue(0.0);
+  EXPECT_DOUBLE_EQ(step.thresholdSpin()->value(), 1e-4) << "no threshold below the slider's range";
+}
+
 TEST(RoiStepWidget, FractionSliderKeepsThatFractionAndLevelsWork) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   fct::RoiStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
   step.fractionSlider()->setValue(25);
   EXPECT_DOUBLE_EQ(session.document.roiParameters().targetFraction, 0.25);
   for (std::size_t v = 0; v < session.document.views().size(); ++v) {
@@ -86,6 +104,7 @@ TEST(RoiStepWidget, ExclusionsAreEditableAndAThresholdAboveEveryWindowSaysSo) {
   fct::RoiStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
   fct::RoiParameters parameters = session.document.roiParameters();
   parameters.margin_px = 40;
   session.document.setRoiParameters(parameters);
@@ -110,6 +129,7 @@ TEST(RoiStepWidget, SwitchingToTheThresholdStartsWhereTheFractionWas) {
   fct::RoiStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
   step.fractionSlider()->setValue(15);
   const double before = step.keptFraction(0);
   auto* thresholdRadio = step.findChild<QRadioButton*>(QString(), Qt::FindChildrenRecursively);
@@ -129,6 +149,7 @@ TEST(RoiStepWidget, CalibrationSpheresAreExcludedAndOutlined) {
   fct::RoiStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
   auto prepared = session.document.preparedCase();
   ASSERT_TRUE(prepared.ok()) << prepared.error();
   EXPECT_FALSE(prepared.value()->prepared(0).pyramid.level(0).mask.isValid(60, 70)) << "the sphere is excluded";
@@ -146,6 +167,7 @@ TEST(RoiStepWidget, SaysWhichMaskExcludedEachPatch) {
   fct::RoiStepWidget step(&session.document);
   step.attachViews(session.xrayViews, session.sliceViews);
   step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
   const QString text = step.exclusionText();
   const QString view = QString::fromStdString(session.document.views()[0].name);
   EXPECT_TRUE(text.contains(view + QStringLiteral(" excluded:"))) << text.toStdString();

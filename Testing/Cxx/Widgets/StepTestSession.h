@@ -137,4 +137,12 @@ inline bool waitUntil(const std::function<bool()>& done, int timeout_ms) {
   return done();
 }
 
+/// Waits (event loop running) until `document`'s case is prepared, starting a background preparation if none runs;
+/// false when it fails or takes longer than `timeout_ms`.
+inline bool waitForCase(StudioDocument& document, int timeout_ms = 60000) {
+  document.prepareCaseInBackground();
+  return waitUntil([&] { return document.readyCase() != nullptr || !document.isPreparingCase(); }, timeout_ms) &&
+         document.readyCase() != nullptr;
+}
+
 }  // namespace fct::test

@@ -289,6 +289,29 @@ TEST(RegistrationCase, FailsClearlyOnAConstantXrayAndAMismatchedDetector) {
   EXPECT_NE(none.error().find("at least one"), std::string::npos) << none.error();
 }
 
+TEST(RegistrationCase, ReportsEachPreparationStepAndStopsWhenCancelled) {
+  auto simulated = fct::test::simulateCase(smallPhantom());
+  ASSERT_TRUE(simulated.ok()) << simulated.error();
+  std::vector<std::string> stages;
+  std::atomic<bool> cancel{false};
+  const fct::ProgressMonitor monitor(
+      [&](const fct::ProgressUpdate& update) {
+        stages.push_back(update.stage);
+        if (update.stage == "views") cancel.store(true);  // the user cancels once the views are under way
+      },
+      &cancel);
+  auto prepared = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {}, monitor);
+  ASSERT_FALSE(prepared.ok());
+  EXPECT_NE(prepared.error().find("cancelled"), std::string::npos) << prepared.error();
+  EXPECT_EQ(stages, (std::vector<std::string>{"CT", "views"})) << "stopped at the next step";
+
+  stages.clear();
+  const fct::ProgressMonitor watching([&](const fct::ProgressUpdate& update) { stages.push_back(update.stage); },
+                                      nullptr);
+  ASSERT_TRUE(fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {}, watching).ok());
+  EXPECT_EQ(stages.size(), simulated.value().views.size() + 2) << "the CT, each view and the bone surface";
+}
+
 TEST(RegistrationCase, RotatesAboutTheBoneCentroidWithScalesFromItsRadius) {
   Prepared p = preparePhantom();
   const auto& bone = *p.registrationCase.bone();
