@@ -15,6 +15,7 @@ namespace {
 constexpr double kClickTolerance_px = 4.0;  ///< a press and release closer than this is a click, not a drag
 constexpr double kPickRadius_px = 8.0;      ///< how near a draggable point a press must be to grab it
 constexpr double kPointRadius_px = 5.0;     ///< drawn radius of an overlay point
+constexpr int kMaxLabelWidth_px = 90;       ///< widest a point label is drawn; longer ones are elided
 
 }  // namespace
 
@@ -304,10 +305,12 @@ void ImageViewWidget::paintEvent(QPaintEvent*) {
             painter.drawLine(p - QPointF(0, 2), p + QPointF(0, 2));
             if (!point.label.isEmpty()) {
               const QPointF at = p + QPointF(kPointRadius_px + 3, -kPointRadius_px);
+              // A long name is elided so that it does not run over its neighbours' markers.
+              const QString label = painter.fontMetrics().elidedText(point.label, Qt::ElideRight, kMaxLabelWidth_px);
               painter.setPen(QColor(0, 0, 0, 200));
-              painter.drawText(at + QPointF(1, 1), point.label);
+              painter.drawText(at + QPointF(1, 1), label);
               painter.setPen(point.color);
-              painter.drawText(at, point.label);
+              painter.drawText(at, label);
             }
           }
           break;

@@ -79,6 +79,7 @@ LandmarkStepWidget::LandmarkStepWidget(StudioDocument* document, QWidget* parent
   m_table->horizontalHeader()->setStretchLastSection(true);
   m_table->verticalHeader()->setVisible(false);
   m_table->setTextElideMode(Qt::ElideRight);
+  m_table->horizontalHeader()->setMaximumSectionSize(kMaxColumnWidth_px);  // a long name is elided (full in its tooltip)
   m_table->viewport()->installEventFilter(this);
   layout->addWidget(m_table, 1);
   m_missing = new QLabel(this);
@@ -535,7 +536,9 @@ void LandmarkStepWidget::refresh() {
   for (std::size_t i = 0; i < landmarks.ct.size(); ++i) {
     const CtLandmark& landmark = landmarks.ct[i];
     const int row = static_cast<int>(i);
-    m_table->setItem(row, kName, new QTableWidgetItem(QString::fromStdString(landmark.name)));
+    auto* nameItem = new QTableWidgetItem(QString::fromStdString(landmark.name));
+    nameItem->setToolTip(nameItem->text());
+    m_table->setItem(row, kName, nameItem);
     m_table->setItem(row, kCt, readOnlyItem(QStringLiteral("%1, %2, %3")
                                                 .arg(landmark.p_ct_mm.x(), 0, 'f', 1)
                                                 .arg(landmark.p_ct_mm.y(), 0, 'f', 1)

@@ -39,6 +39,8 @@ class LandmarkStepWidget : public QWidget {
  public:
   /// Name of the X-ray point layer of the clicked partners (draggable).
   static inline const QString kClickLayer = QStringLiteral("landmarks");
+  /// Widest a table column gets, pixels: a longer name is elided (the full name is its tooltip).
+  static constexpr int kMaxColumnWidth_px = 160;
   /// Name of the X-ray point layer of the CT landmarks projected at the computed pose.
   static inline const QString kProjectedLayer = QStringLiteral("landmarks-projected");
 

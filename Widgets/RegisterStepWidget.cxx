@@ -13,10 +13,15 @@
 #include <QSpinBox>
 #include <QThread>
 #include <QVBoxLayout>
+#include <QtConcurrent/QtConcurrentRun>
+
+#include <algorithm>
+#include <exception>
 
 #include <fmt/format.h>
 
 #include "Widgets/RegistrationWorker.h"
+#include "Widgets/RunTimeEstimator.h"
 #include "Widgets/StudioDocument.h"
 
 namespace fct {
@@ -34,6 +39,12 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   m_presetCombo->setToolTip(tr("fast: a small genetic search, then VLNC on ROIs at 1:16, 1:4, 1:1; paper: the paper's "
                                "three stages with n = 4 genetic guesses"));
   form->addRow(tr("Preset"), m_presetCombo);
+  m_estimateLabel = new QLabel(optionsBox);
+  m_estimateLabel->setWordWrap(true);
+  m_estimateLabel->setToolTip(tr("Each stage's evaluation cap times the DRR pixels it renders, at the DRR speed "
+                                 "measured on this case at the initial pose; a search usually stops before its cap, "
+                                 "and comparing the images costs extra. Without ablation switches."));
+  form->addRow(tr("Time (estimate)"), m_estimateLabel);
   m_seedSpin = new QSpinBox(optionsBox);
   m_seedSpin->setRange(0, 1000000);
   form->addRow(tr("Random seed"), m_seedSpin);
@@ -102,6 +113,16 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
     });
   }
   connect(m_document, &StudioDocument::casePreparationFinished, this, &RegisterStepWidget::onCasePrepared);
+  m_speedWatcher = new QFutureWatcher<Speed>(this);
+  connect(m_speedWatcher, &QFutureWatcherBase::finished, this, [this] {
+    m_speed = m_speedWatcher->result();
+    updateEstimate();
+  });
+  connect(m_document, &StudioDocument::casePreparationFinished, this, &RegisterStepWidget::updateEstimate);
+  for (auto signal : {&StudioDocument::initialPoseChanged, &StudioDocument::roiParametersChanged, &StudioDocument::resultChanged,
+                      &StudioDocument::registrationOptionsChanged}) {
+    connect(m_document, signal, this, &RegisterStepWidget::updateEstimate);
+  }
   connect(m_document, &StudioDocument::casePreparationProgressed, this, [this](const QString& step, double fraction) {
     if (!m_pending) return;
     m_progressBar->setValue(0);
@@ -112,6 +133,7 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
 }
 
 RegisterStepWidget::~RegisterStepWidget() {
+  m_speedWatcher->waitForFinished();
   if (m_pending) m_document->cancelCasePreparation();
   if (m_worker) m_worker->cancel();
   endThread();
@@ -120,6 +142,8 @@ RegisterStepWidget::~RegisterStepWidget() {
 void RegisterStepWidget::attachViews(std::vector<XrayViewWidget*>, std::array<SliceViewWidget*, 3>) {}
 
 void RegisterStepWidget::setActive(bool active) {
+  m_active = active;
+  updateEstimate();
   if (!active || isRunning()) return;
   const RoiParameters& roi = m_document->roiParameters();
   if (!m_document->initialPose()) {
@@ -174,6 +198,74 @@ void RegisterStepWidget::updateRunButton() {
   m_runButton->setEnabled(!isRunning() && missing.isEmpty());
   m_runButton->setToolTip(missing.isEmpty() ? tr("Register the CT to the X-rays from the initial pose")
                                             : tr("Run needs %1").arg(missing));
+}
+
+std::optional<double> RegisterStepWidget::estimatedSeconds(const QString& preset) const {
+  const std::shared_ptr<RegistrationCase>& prepared = m_document->readyCase();
+  if (!prepared || prepared.get() != m_speedCase || m_speed.secondsPerPixel.empty()) return std::nullopt;
+  auto schedule = RegistrationSchedule::resolve(preset.toStdString());
+  if (!schedule) return std::nullopt;
+  const RoiParameters& roi = m_document->roiParameters();
+  auto tuned = schedule.value().withRoiPixels(roi.windowSize, roi.targetFraction);  // as Run will use it
+  if (!tuned) return std::nullopt;
+  auto seconds = RunTimeEstimator::budgetSeconds(tuned.value(), *prepared, m_speed.secondsPerPixel);
+  return seconds ? std::optional<double>(seconds.value()) : std::nullopt;
+}
+
+QString RegisterStepWidget::estimateText() const { return m_estimateLabel->text(); }
+
+void RegisterStepWidget::updateEstimate() {
+  const auto duration = [](double seconds) {
+    return seconds < 90.0 ? tr("%1 s").arg(std::max(1.0, seconds), 0, 'f', 0) : tr("%1 min").arg(seconds / 60.0, 0, 'f', 1);
+  };
+  const std::shared_ptr<RegistrationCase>& prepared = m_document->readyCase();
+  if (!m_document->ct() || m_document->views().empty() || !m_document->initialPose()) {
+    m_estimateLabel->setText(tr("after the data and an initial pose are set"));
+    return;
+  }
+  if (!prepared) {
+    m_estimateLabel->setText(tr("once the case is prepared"));
+    if (m_active && !isRunning()) m_document->prepareCaseInBackground();
+    return;
+  }
+  if (prepared.get() != m_speedCase) {
+    if (m_speedWatcher->isRunning()) return;  // finished() comes back here
+    if (!m_active || isRunning()) return;     // the case is busy with a run; measured when the step is shown again
+    m_speedCase = prepared.get();
+    m_speed = Speed{};
+    m_estimateLabel->setText(tr("measuring the DRR speed on this case…"));
+    const Eigen::Isometry3d pose = *m_document->initialPose();
+    m_speedWatcher->setFuture(QtConcurrent::run([prepared, pose]() -> Speed {
+      try {
+        auto measured = RunTimeEstimator::measureSecondsPerPixel(*prepared, pose);
+        if (!measured) return Speed{{}, QString::fromStdString(measured.error())};
+        return Speed{std::move(measured).value(), QString()};
+      } catch (const std::exception& error) {
+        return Speed{{}, QString::fromUtf8(error.what())};
+      }
+    }));
+    return;
+  }
+  if (m_speedWatcher->isRunning()) return;
+  if (m_speed.secondsPerPixel.empty()) {
+    m_estimateLabel->setText(tr("none: %1").arg(m_speed.error));
+    return;
+  }
+  QStringList parts;
+  for (int i = 0; i < m_presetCombo->count(); ++i) {
+    const QString preset = m_presetCombo->itemText(i);
+    if (const auto seconds = estimatedSeconds(preset)) parts << tr("%1 about %2").arg(preset, duration(*seconds));
+  }
+  QString text = parts.join(QStringLiteral(" · "));
+  const std::string current = m_document->registrationOptions().preset;
+  const auto& results = m_document->results();
+  for (auto it = results.rbegin(); it != results.rend(); ++it) {
+    if (it->result.schedule.name == current && !it->result.cancelled) {
+      text += tr("; the last %1 run here took %2").arg(QString::fromStdString(current), duration(it->result.totalSeconds));
+      break;
+    }
+  }
+  m_estimateLabel->setText(text);
 }
 
 QString RegisterStepWidget::plainStageName(const std::string& stage) {
@@ -326,6 +418,7 @@ void RegisterStepWidget::onCasePrepared(bool prepared, const QString& why) {
 }
 
 void RegisterStepWidget::startRegistration() {
+  m_speedWatcher->waitForFinished();  // the DRR speed calibration uses the case too (a fraction of a second)
   m_runTimer.start();
   m_worker = new RegistrationWorker(m_document->readyCase(), m_pending->T_initial, std::move(m_pending->options));
   m_pending.reset();

@@ -8,6 +8,7 @@
 // is accepted, which only the user replaces (Review step).
 
 #include <QElapsedTimer>
+#include <QFutureWatcher>
 #include <QString>
 #include <QWidget>
 
@@ -65,6 +66,11 @@ class RegisterStepWidget : public QWidget {
   QPushButton* runButton() const { return m_runButton; }
   /// The progress line under the bar, as shown.
   QString progressText() const;
+  /// The estimated run time of `preset` (a built-in name) on the current case, seconds, once the DRR speed has been
+  /// measured on it (see RunTimeEstimator); nullopt before.
+  std::optional<double> estimatedSeconds(const QString& preset) const;
+  /// The estimate line beside the preset chooser, as shown.
+  QString estimateText() const;
   /// A preset stage's name in words for the progress line and log: "whole" stages are the coarse alignment on whole
   /// images, a 1:1 ROI stage the final one at full resolution, other ROI stages the refinement on bone edges; the
   /// preset's own name is kept in brackets ("Refinement (bone edges, 1:4) [vlnc-rois-1:4]").
@@ -88,6 +94,8 @@ class RegisterStepWidget : public QWidget {
   void onCasePrepared(bool prepared, const QString& why);
   /// Starts the pending run on the document's ready case, on a worker thread.
   void startRegistration();
+  /// Shows the time estimate of every preset; prepares the case and measures the DRR speed on it when needed.
+  void updateEstimate();
   void onProgress(const RegistrationProgress& progress);
   void onFinished(const RegistrationResult& result);
   void onFailed(const QString& message);
@@ -123,8 +131,18 @@ class RegisterStepWidget : public QWidget {
   bool m_inputsChangedDuringRun = false;  ///< the CT or views changed while the run went on: its result is stale
   bool m_ranHere = false;                 ///< a run of this widget is shown (not a result from the session)
   QElapsedTimer m_runTimer;               ///< since the current run started (for the time left)
+  bool m_active = false;
+  /// The DRR speed calibration: seconds per pixel per level (empty and an error on failure).
+  struct Speed {
+    std::vector<double> secondsPerPixel;
+    QString error;
+  };
+  QFutureWatcher<Speed>* m_speedWatcher;
+  const RegistrationCase* m_speedCase = nullptr;  ///< the case m_speed was measured on (compared, never used)
+  Speed m_speed;
 
   QComboBox* m_presetCombo;
+  QLabel* m_estimateLabel;
   QSpinBox* m_seedSpin;
   QComboBox* m_methodCombo;
   QCheckBox* m_noRoisCheck;

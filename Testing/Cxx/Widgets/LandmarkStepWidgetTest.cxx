@@ -279,3 +279,49 @@ TEST(LandmarkStepWidget, CtrlZInTheWindowUndoesTheLastEdit) {
   QTest::keyClick(session.window.get(), Qt::Key_Z, Qt::ControlModifier | Qt::ShiftModifier);
   EXPECT_EQ(session.document.landmarks().ct.size(), 1u) << step->message().toStdString();
 }
+
+TEST(LandmarkStepWidget, ALandmarkCanBeDraggedInTheCtSlice) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::LandmarkStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  const auto targets = session.spreadBonePoints();
+  ASSERT_GE(targets.size(), 1u);
+  session.clickCt(targets[0]);
+  ASSERT_EQ(session.document.landmarks().ct.size(), 1u);
+  const Eigen::Vector3d placed = session.document.landmarks().ct[0].p_ct_mm;
+  fct::SliceViewWidget* axial = session.sliceViews[0];
+  const QPoint marker = axial->widgetPointForCtPoint(placed);
+  const QPoint target = marker + QPoint(25, 10);
+  QTest::mousePress(axial, Qt::LeftButton, Qt::NoModifier, marker);
+  QTest::mouseMove(axial, target);
+  QTest::mouseRelease(axial, Qt::LeftButton, Qt::NoModifier, target);
+  ASSERT_EQ(session.document.landmarks().ct.size(), 1u) << "the drag moved the landmark, it added none";
+  const Eigen::Vector3d moved = session.document.landmarks().ct[0].p_ct_mm;
+  EXPECT_GT((moved - placed).norm(), 5.0) << "it moved";
+  EXPECT_NEAR(moved.z(), placed.z(), 1e-6) << "within the axial plane";
+  EXPECT_LE((axial->widgetPointForCtPoint(moved) - target).manhattanLength(), 2) << "to where it was dropped";
+  step.undo();
+  EXPECT_TRUE(session.document.landmarks().ct[0].p_ct_mm.isApprox(placed)) << "one drag is one undo step";
+}
+
+TEST(LandmarkStepWidget, ALongNameIsElidedInTheTableWithTheFullNameInItsTooltip) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::LandmarkStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  step.resize(420, 500);
+  step.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&step));
+  step.addCtLandmark(Eigen::Vector3d(1, 2, 3));
+  const QString longName = QStringLiteral("left anterior superior iliac spine, most prominent point");
+  ASSERT_TRUE(step.renameLandmark(QStringLiteral("L1"), longName));
+  QTableWidget* table = step.table();
+  QTableWidgetItem* item = table->item(0, 0);
+  ASSERT_NE(item, nullptr);
+  EXPECT_EQ(item->text(), longName);
+  EXPECT_EQ(item->toolTip(), longName);
+  EXPECT_LE(table->columnWidth(0), fct::LandmarkStepWidget::kMaxColumnWidth_px);
+  EXPECT_LT(table->columnWidth(0), table->fontMetrics().horizontalAdvance(longName)) << "the name is cut, not the columns";
+  EXPECT_GT(table->columnWidth(1), 0) << "the CT column stays in view";
+}

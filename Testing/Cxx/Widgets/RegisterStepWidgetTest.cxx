@@ -159,3 +159,29 @@ TEST(RegisterStepWidget, RunIsDisabledWithoutDataAndItsTooltipSaysWhatIsMissing)
   setStartPose(session, 3.0);
   EXPECT_TRUE(step.runButton()->isEnabled());
 }
+
+TEST(RegisterStepWidget, EachPresetShowsAnEstimatedTimeBeforeARun) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  step.setActive(true);
+  EXPECT_FALSE(step.estimatedSeconds(QStringLiteral("fast")).has_value()) << "no initial pose, nothing measured";
+  setStartPose(session, 5.0);
+  ASSERT_TRUE(fct::test::waitUntil([&] { return step.estimatedSeconds(QStringLiteral("paper")).has_value(); }, 60000))
+      << step.estimateText().toStdString();
+  const double fast_s = *step.estimatedSeconds(QStringLiteral("fast"));
+  const double paper_s = *step.estimatedSeconds(QStringLiteral("paper"));
+  std::printf("estimated: fast about %.1f s, paper about %.1f s (%s)\n", fast_s, paper_s,
+              step.estimateText().toStdString().c_str());
+  EXPECT_GT(fast_s, 0.0);
+  EXPECT_GT(paper_s, fast_s) << "the paper's preset has the larger DRR budget";
+  EXPECT_TRUE(step.estimateText().contains(QStringLiteral("fast about"))) << step.estimateText().toStdString();
+  EXPECT_TRUE(step.estimateText().contains(QStringLiteral("paper about"))) << step.estimateText().toStdString();
+
+  ASSERT_TRUE(step.run()) << step.message().toStdString();
+  ASSERT_TRUE(fct::test::waitUntil([&] { return !step.isRunning(); }, 120000));
+  ASSERT_NE(session.document.result(), nullptr);
+  std::printf("the fast run took %.2f s (%ld DRRs)\n", session.document.result()->totalSeconds,
+              session.document.result()->totalDrrs);
+  EXPECT_TRUE(step.estimateText().contains(QStringLiteral("the last fast run here took")))
+      << step.estimateText().toStdString();
+}

@@ -12,6 +12,7 @@
 #include <QTest>
 #include <QTimer>
 
+#include <algorithm>
 #include <fstream>
 
 #include "StudioTestCase.h"
@@ -180,6 +181,48 @@ TEST_F(StudioMainWindowTest, XraysOpenAtAReadableWindowAndTheUsersWindowIsSavedI
   EXPECT_DOUBLE_EQ(window.xrayViews()[0]->window(), userWindow);
   EXPECT_DOUBLE_EQ(window.xrayViews()[0]->level(), userLevel);
   EXPECT_FALSE(window.document()->isModified());
+}
+
+TEST_F(StudioMainWindowTest, TheViewMenusXrayPresetsSetEveryXrayViewsWindow) {
+  StudioMainWindow window(m_folder / "autosave.json");
+  window.resize(1400, 900);
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  openBuiltinCase(window);
+  ASSERT_EQ(window.xrayViews().size(), 2u);
+  const auto trigger = [&](fct::XrayWindowPreset preset) {
+    const QString text = QStringLiteral("X-ray window: %1").arg(fct::XrayViewWidget::presetName(preset));
+    for (QAction* menu : window.menuBar()->actions()) {
+      if (!menu->menu()) continue;
+      for (QAction* action : menu->menu()->actions()) {
+        if (action->text() == text) {
+          action->trigger();
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  std::vector<double> automatic;
+  for (fct::XrayViewWidget* view : window.xrayViews()) automatic.push_back(view->window());
+  ASSERT_TRUE(trigger(fct::XrayWindowPreset::FullRange)) << "View > X-ray window: Full range";
+  std::vector<double> full;
+  for (fct::XrayViewWidget* view : window.xrayViews()) {
+    const auto [low, high] = std::minmax_element(view->image().pixels.begin(), view->image().pixels.end());
+    EXPECT_LE(view->window(), *high - *low + 1e-6) << "no wider than the image's range";
+    full.push_back(view->window());
+  }
+  ASSERT_TRUE(trigger(fct::XrayWindowPreset::WholeField));
+  for (std::size_t v = 0; v < window.xrayViews().size(); ++v) {
+    const double field = window.xrayViews()[v]->window();
+    EXPECT_LT(field, full[v]) << "the 1st-99th percentile is narrower than the full range, view " << v;
+    EXPECT_GT(field, automatic[v]) << "and wider than the patient's window (the direct exposure is bright)";
+  }
+  EXPECT_EQ(window.document()->xrayWindows().size(), window.xrayViews().size()) << "a preset is saved per view";
+  ASSERT_TRUE(trigger(fct::XrayWindowPreset::Automatic));
+  for (std::size_t v = 0; v < window.xrayViews().size(); ++v) {
+    EXPECT_DOUBLE_EQ(window.xrayViews()[v]->window(), automatic[v]) << "back to the window it opened at";
+  }
 }
 
 TEST_F(StudioMainWindowTest, ReopeningASessionRestoresResidualsProjectedLandmarksAndTheRegisterState) {

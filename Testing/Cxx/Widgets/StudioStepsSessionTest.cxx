@@ -49,6 +49,7 @@ void runScriptedSession(fct::test::StepTestSession& session, const std::string& 
 
   // ROIs: a higher threshold keeps less; back to the paper's 12 % for the registration.
   rois.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << rois.message().toStdString();
   rois.fractionSlider()->setValue(12);
   const double atTwelve = rois.keptFraction(0);
   EXPECT_NEAR(atTwelve, 0.12, 0.02);
