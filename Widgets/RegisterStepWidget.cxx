@@ -475,6 +475,7 @@ void RegisterStepWidget::onFinished(const RegistrationResult& result) {
   endThread();
   logStages(result);
   QString summary = tr("%1 DRRs in %2 s").arg(result.totalDrrs).arg(result.totalSeconds, 0, 'f', 1);
+  m_progressLabel->setText(result.cancelled ? tr("Cancelled after %1").arg(summary) : tr("Finished: %1").arg(summary));
   if (result.cancelled) {
     summary = tr("Cancelled: the best pose so far is kept, marked cancelled (%1).").arg(summary);
   } else {
