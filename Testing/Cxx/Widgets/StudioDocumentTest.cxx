@@ -109,6 +109,55 @@ TEST(StudioDocument, PreparedCaseNeedsCtAndViewsAndIsKeptUntilTheyChange) {
   EXPECT_NE(first.value().get(), rebuilt.value().get());
 }
 
+TEST(StudioDocument, TheCaseIsPreparedInTheBackgroundAndAnInputChangeOrCancelDropsIt) {
+  const auto dir = fct::test::builtinCaseDir();
+  ASSERT_FALSE(dir.empty());
+  StudioDocument document;
+  QSignalSpy finished(&document, &StudioDocument::casePreparationFinished);
+  document.prepareCaseInBackground();
+  ASSERT_TRUE(finished.wait(10000)) << "it cannot start without data, and says so";
+  EXPECT_FALSE(finished.last().at(0).toBool());
+  EXPECT_TRUE(finished.last().at(1).toString().contains(QStringLiteral("Data step")));
+  ASSERT_TRUE(document.loadCt(dir / "ct.nrrd").ok());
+  ASSERT_TRUE(document.loadViews(dir / "views.json").ok());
+
+  QSignalSpy progressed(&document, &StudioDocument::casePreparationProgressed);
+  finished.clear();
+  document.prepareCaseInBackground();
+  EXPECT_TRUE(document.isPreparingCase());
+  EXPECT_EQ(document.readyCase(), nullptr) << "nothing is ready while it runs";
+  ASSERT_TRUE(finished.wait(60000));
+  EXPECT_TRUE(finished.last().at(0).toBool()) << finished.last().at(1).toString().toStdString();
+  ASSERT_NE(document.readyCase(), nullptr);
+  EXPECT_FALSE(document.isPreparingCase());
+  EXPECT_GE(progressed.count(), 1) << "the steps were reported";
+  EXPECT_EQ(document.preparedCase().value().get(), document.readyCase().get()) << "the same case for everyone";
+
+  // An exclusion changed during a preparation: that preparation is dropped, with the reason.
+  fct::RoiParameters roi = document.roiParameters();
+  roi.margin_px = 12;
+  document.setRoiParameters(roi);
+  EXPECT_EQ(document.readyCase(), nullptr);
+  finished.clear();
+  document.prepareCaseInBackground();
+  roi.margin_px = 14;
+  document.setRoiParameters(roi);
+  EXPECT_FALSE(document.isPreparingCase());
+  ASSERT_TRUE(finished.wait(10000));
+  EXPECT_FALSE(finished.last().at(0).toBool());
+  EXPECT_TRUE(finished.last().at(1).toString().contains(QStringLiteral("changed"))) << finished.last().at(1).toString().toStdString();
+
+  // Cancelled: it ends with an error and no case; the next request prepares again.
+  finished.clear();
+  document.prepareCaseInBackground();
+  document.cancelCasePreparation();
+  ASSERT_TRUE(finished.wait(60000));
+  EXPECT_FALSE(finished.last().at(0).toBool());
+  EXPECT_TRUE(finished.last().at(1).toString().contains(QStringLiteral("cancelled"))) << finished.last().at(1).toString().toStdString();
+  EXPECT_EQ(document.readyCase(), nullptr);
+  EXPECT_TRUE(document.preparedCase().ok()) << "a later request prepares it";
+}
+
 TEST(StudioDocument, ClearEmptiesEverythingAndIsNotModified) {
   const auto dir = fct::test::builtinCaseDir();
   ASSERT_FALSE(dir.empty());
