@@ -129,13 +129,7 @@ void expectStartAtTruthStays(const Model& model) {
 std::vector<fct::RegistrationView> simulateWith(const fct::Volume& ct, const Eigen::Isometry3d& T_truth,
                                                 const std::function<void(fct::FluoroscopyOptions&)>& edit,
                                                 std::uint32_t seed) {
-  fct::FluoroscopyOptions options;
-  options.patientExtension_mm = 60.0;
-  options.scatterToPrimary = 0.1;
-  options.scatterSigma_mm = 40.0;
-  options.photonsPerPixel = 10000.0;
-  options.psfSigma_px = 0.7;
-  options.vignetting = 0.1;
+  fct::FluoroscopyOptions options = fct::StudyXraySource::forwardModel(false);
   edit(options);
   std::vector<fct::RegistrationView> out;
   for (const fct::ViewSpec& view : views()) {
