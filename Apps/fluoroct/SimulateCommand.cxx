@@ -31,7 +31,8 @@ constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", 
                                          "--offset",      "--gamma",            "--pincushion", "--s-distortion-deg",
                                          "--vignetting",  "--collimator",       "--kwires",     "--screws",
                                          "--plate",       "--spheres",          "--sphere-pitch-mm",
-                                         "--fixed-exposure", "--gas-pockets", "--grid-pitch-mm"};
+                                         "--fixed-exposure", "--gas-pockets", "--grid-pitch-mm",
+                                         "--patient-extension-mm", "--scatter-to-primary", "--scatter-sigma-mm"};
 /// Options that only the DRR model reads.
 constexpr const char* kDrrOnly[] = {"--method", "--i0"};
 
@@ -84,6 +85,16 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
   FluoroscopyOptions& p = options->physical;
   command->add_option("--kvp", p.tubeVoltage_kvp, "physical: tube voltage, 50..120 kVp")->capture_default_str();
   command->add_option("--filtration-mm-al", p.filtration_mmAl, "physical: total tube filtration in mm Al")
+      ->capture_default_str();
+  command->add_option("--patient-extension-mm", p.patientExtension_mm,
+                      "physical: the patient continues this far (mm, 0..1000) beyond the CT's end faces along its slice "
+                      "axis, as anatomy above and below a CT slab does")
+      ->capture_default_str();
+  command->add_option("--scatter-to-primary", p.scatterToPrimary,
+                      "physical: scatter haze, this fraction (0..5) of the blurred primary signal is added; 0 = none")
+      ->capture_default_str();
+  command->add_option("--scatter-sigma-mm", p.scatterSigma_mm,
+                      "physical: scatter haze blur, Gaussian sigma on the detector in mm (1..500)")
       ->capture_default_str();
   command->add_flag("--fixed-exposure", [options](std::int64_t) { options->physical.automaticExposure = false; },
                     "physical: no automatic exposure: --dose and --gain refer to an unattenuated ray instead of the "

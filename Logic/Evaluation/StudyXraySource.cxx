@@ -5,16 +5,13 @@
 #include <cmath>
 
 #include "Simulation/CtSliceDegrader.h"
-#include "Simulation/FluoroscopySimulator.h"
 
 namespace fct {
-
-namespace {
 
 /// The simulated C-arm and patient: the CT's continuous interpolant continued 60 mm beyond its end faces, 80 kVp
 /// polyenergetic beam, a scatter haze (scatter-to-primary 0.1, sigma 40 mm: a C-arm with an anti-scatter grid), quantum noise, detector blur and
 /// vignetting; with foreign objects, 2 K-wires and 2 screws; no distortion or collimator (studied separately).
-FluoroscopyOptions studyOptions(bool foreignObjects) {
+FluoroscopyOptions StudyXraySource::forwardModel(bool foreignObjects) {
   FluoroscopyOptions o;
   o.patient = PatientModel::CubicBspline;
   o.patientExtension_mm = 60.0;
@@ -31,10 +28,8 @@ FluoroscopyOptions studyOptions(bool foreignObjects) {
   return o;
 }
 
-}  // namespace
-
 std::string StudyXraySource::description() {
-  const FluoroscopyOptions o = studyOptions(true);
+  const FluoroscopyOptions o = forwardModel(true);
   return fmt::format("FluoroscopySimulator on the original CT as a continuous patient (its cubic B-spline interpolant, "
                      "continued {:g} mm beyond the CT's end faces by mirroring the end slabs; no voxel edges), {:g} kVp "
                      "spectrum with NIST attenuation, scatter haze (scatter-to-primary {:g}, sigma {:g} mm), automatic "
@@ -48,7 +43,7 @@ std::string StudyXraySource::description() {
 Result<std::vector<RegistrationView>> StudyXraySource::simulate(const Volume& ct, const std::vector<ViewSpec>& views,
                                                                 const Eigen::Isometry3d& T_world_from_ct,
                                                                 std::uint32_t seed, bool foreignObjects) {
-  FluoroscopyOptions options = studyOptions(foreignObjects);
+  FluoroscopyOptions options = forwardModel(foreignObjects);
   options.seed = seed;
   std::vector<RegistrationView> out;
   for (std::size_t v = 0; v < views.size(); ++v) {

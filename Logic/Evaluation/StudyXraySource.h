@@ -15,6 +15,7 @@
 #include "Image/Volume.h"
 #include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationView.h"
+#include "Simulation/FluoroscopySimulator.h"
 
 namespace fct {
 
@@ -23,6 +24,9 @@ class StudyXraySource {
  public:
   /// One line naming the forward model in use, for reports.
   static std::string description();
+  /// The simulator settings of every study X-ray (patient, beam, haze, detector), with 2 K-wires and 2 screws when
+  /// `foreignObjects`; simulate() adds the seed.
+  static FluoroscopyOptions forwardModel(bool foreignObjects);
   /// Simulated X-rays of `ct` (LPS mm) at T_world_from_ct for every view (detector sizes from the cameras), view n
   /// with noise seed `seed + n`, with foreign objects (placed by `seed`) when `foreignObjects`. Fails, naming the
   /// view, on a rendering or simulation error.

@@ -146,7 +146,7 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
   const auto run = fct::test::runCli(fmt::format(
       "simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --model physical --kvp 75 --dose 2000 --psf-px 0.8 "
       "--pincushion 0.03 --vignetting 0.2 --collimator 1.1 --kwires 1 --screws 1 --plate --gas-pockets 1 --spheres "
-      "--sphere-pitch-mm 50 "
+      "--sphere-pitch-mm 50 --patient-extension-mm 30 --scatter-to-primary 0.2 --scatter-sigma-mm 25 "
       "--ct-slice-mm 8",
       (dir / "ct.nrrd").string(), (dir / "views.json").string(), (dir / "pose.json").string(), out.string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
@@ -172,6 +172,9 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
   EXPECT_NE(text.find("\"slice_spacing_mm\": 8"), std::string::npos) << text;
   EXPECT_NE(text.find("\"kind\": \"plate\""), std::string::npos) << text;
   EXPECT_NE(text.find("\"kind\": \"gas_pocket\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"patient_extension_mm\": 30"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"scatter_to_primary\": 0.2"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"scatter_sigma_mm\": 25"), std::string::npos) << text;
 }
 
 TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
@@ -182,7 +185,9 @@ TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
   for (const std::string& extra :
        {std::string(" --model physical --kvp 200"), std::string(" --model physical --dose -1"),
         std::string(" --model physical --pincushion 0.5"), std::string(" --model physical --method raycast"),
-        std::string(" --kwires 2"), std::string(" --model xray"), std::string(" --model physical --ct-slice-mm 2")}) {
+        std::string(" --kwires 2"), std::string(" --model xray"), std::string(" --model physical --ct-slice-mm 2"),
+        std::string(" --model physical --patient-extension-mm -5"), std::string(" --model physical --scatter-to-primary 6"),
+        std::string(" --model physical --scatter-sigma-mm 0.5"), std::string(" --scatter-to-primary 0.1")}) {
     SCOPED_TRACE(extra);
     expectOneErrorLine(base + extra);
   }
