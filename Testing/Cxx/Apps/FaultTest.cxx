@@ -1,4 +1,5 @@
-// Faults the CLI survives: a file-size limit (as a full disk) while writing RESULT.json, kill -9 in the middle of a
+// Faults the CLI survives: a file-size limit (as a full disk) while writing RESULT.json, a truncated Transgraph cache
+// (rebuilt with a warning), kill -9 in the middle of a
 // study (the resume loses at most the trials that were running), and Ctrl-C during `register` (the best pose so far
 // is written, marked cancelled).
 #include <fmt/core.h>
@@ -166,4 +167,26 @@ TEST(RegisterFault, CtrlCWritesTheBestPoseSoFarMarkedCancelled) {
   auto pose = fct::PoseFile::read(dir / "RESULT.json");
   ASSERT_TRUE(pose.ok()) << pose.error();
   EXPECT_TRUE(pose.value().matrix().allFinite());
+}
+
+TEST(RegisterFault, TruncatedTransgraphCacheIsRebuiltWithAWarning) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = fct::test::makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(fct::test::perturbed(truth), dir / "init.json").ok());
+  const fs::path cache = dir / "cache";
+  const std::string arguments = fmt::format(
+      "register --ct '{}' --views '{}' --init '{}' --preset fast --method transgraph --transgraph-spacing-mm 12 "
+      "--transgraph-cache '{}' --out '{}'",
+      (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(), cache.string(),
+      (dir / "RESULT.json").string());
+  ASSERT_EQ(fct::test::runCli(arguments).exitCode, 0);
+  const fs::path table = fs::directory_iterator(cache)->path();
+  const auto size = fs::file_size(table);
+  fs::resize_file(table, size / 3);  // as after a crash of a writer that did not write atomically
+
+  const auto run = fct::test::runCli(arguments);
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.err.find("is unusable"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("rebuilt it"), std::string::npos) << run.err;
+  EXPECT_EQ(fs::file_size(table), size) << "the rebuilt table was written back";
 }
