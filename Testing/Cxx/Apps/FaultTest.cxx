@@ -1,7 +1,6 @@
 // Faults the CLI survives: a file-size limit (as a full disk) while writing RESULT.json, a truncated Transgraph cache
-// (rebuilt with a warning), kill -9 in the middle of a
-// study (the resume loses at most the trials that were running), and Ctrl-C during `register` (the best pose so far
-// is written, marked cancelled).
+// (rebuilt with a warning), kill -9 in the middle of a study (the resume loses at most the trials that were running),
+// and Ctrl-C during `register` (the best pose so far is written, marked cancelled).
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <signal.h>
