@@ -5,6 +5,8 @@ set -euo pipefail
 
 FCT_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 FCT_BUILD="${FCT_BUILD_DIR:-$FCT_ROOT/build}"
+# FCT_CMAKE_ARGS, FCT_BUILD_TARGETS (arrays, optional): extra CMake arguments of the first configure and the targets
+# to build (default: all); the sanitizer build of scripts/test.sh sets them.
 
 FCT_PACKAGES=(
   cmake ninja-build ccache g++ pkg-config
@@ -42,9 +44,9 @@ fct_build() {
   # Relative paths in ccache's keys, so that clones in other folders (CI) reuse the cache.
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$FCT_ROOT}"
   if [[ ! -f "$FCT_BUILD/build.ninja" ]]; then
-    cmake -S "$FCT_ROOT" -B "$FCT_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release
+    cmake -S "$FCT_ROOT" -B "$FCT_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release "${FCT_CMAKE_ARGS[@]}"
   fi
-  cmake --build "$FCT_BUILD" -j "$jobs"
+  cmake --build "$FCT_BUILD" -j "$jobs" ${FCT_BUILD_TARGETS[@]+--target "${FCT_BUILD_TARGETS[@]}"}
 }
 
 fct_install_packages

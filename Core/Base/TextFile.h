@@ -15,8 +15,8 @@ class TextFile {
   /// The whole content of a file. Fails with a message naming the path if it is missing, a folder or unreadable.
   static Result<std::string> read(const std::filesystem::path& path);
 
-  /// Writes `contents` to a temporary file beside `path`, flushes it to disk and renames it over `path`. On any
-  /// failure the temporary file is removed, `path` is left as it was, and the message names the path and the cause.
+  /// Writes `contents` to `path` with AtomicFile: on any failure `path` is left as it was and the message names the
+  /// path and the cause.
   static Status writeAtomically(const std::filesystem::path& path, const std::string& contents);
 };
 

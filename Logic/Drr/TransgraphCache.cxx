@@ -1,5 +1,7 @@
 #include "Drr/TransgraphCache.h"
 
+#include "Base/AtomicFile.h"
+
 #include <fmt/core.h>
 
 #include <chrono>
@@ -10,7 +12,6 @@
 #include <fstream>
 #include <string_view>
 #include <system_error>
-#include <unistd.h>
 
 namespace fct {
 
@@ -183,26 +184,9 @@ Status TransgraphCache::save(const std::filesystem::path& file, std::uint64_t ke
   checksum.bytes(table.data(), table.size() * sizeof(float));
   const std::uint64_t digest = checksum.digest();
 
-  std::filesystem::path temp = file;
-  temp += fmt::format(".tmp{}", static_cast<long>(::getpid()));
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) return fail(fmt::format("cannot write cache file {}", temp.string()));
-    out.write(header.data(), static_cast<std::streamsize>(header.size()));
-    out.write(reinterpret_cast<const char*>(table.data()), static_cast<std::streamsize>(table.size() * sizeof(float)));
-    out.write(reinterpret_cast<const char*>(&digest), sizeof(digest));
-    out.close();
-    if (!out) {
-      std::filesystem::remove(temp, ec);
-      return fail(fmt::format("writing cache file {} failed (disk full?)", temp.string()));
-    }
-  }
-  std::filesystem::rename(temp, file, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    return fail(fmt::format("cannot move the cache file into place at {}", file.string()));
-  }
-  return Ok{};
+  return AtomicFile::write(file, {AtomicFile::bytesOf(header.data(), header.size()),
+                                  AtomicFile::bytesOf(table.data(), table.size()),
+                                  AtomicFile::bytesOf(&digest, 1)});
 }
 
 Result<TransgraphCache::Entry> TransgraphCache::load(const std::filesystem::path& file, std::uint64_t key,

@@ -2,8 +2,11 @@
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -75,6 +78,36 @@ ProcessResult runCommand(const std::string& commandLine) {
 
 ProcessResult runCli(const std::string& arguments) {
   return runCommand(fmt::format("'{}' {}", cliPath().string(), arguments));
+}
+
+ProcessResult runCliWithFileSizeLimit(const std::string& arguments, long maxFileBytes) {
+  // An ignored signal stays ignored across exec; prlimit (util-linux) sets the limit of the program it runs.
+  return runCommand(fmt::format("trap '' XFSZ; exec prlimit --fsize={} '{}' {}", maxFileBytes, cliPath().string(),
+                                arguments));
+}
+
+FileSizeLimit::FileSizeLimit(long maxFileBytes) {
+  rlimit limit{};
+  ::getrlimit(RLIMIT_FSIZE, &limit);
+  m_previousSoftLimit = limit.rlim_cur;
+  limit.rlim_cur = static_cast<rlim_t>(maxFileBytes);
+  EXPECT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0) << "cannot lower the file-size limit";
+  m_previousHandler = std::signal(SIGXFSZ, SIG_IGN);
+}
+
+FileSizeLimit::~FileSizeLimit() {
+  rlimit limit{};
+  ::getrlimit(RLIMIT_FSIZE, &limit);
+  limit.rlim_cur = static_cast<rlim_t>(m_previousSoftLimit);
+  ::setrlimit(RLIMIT_FSIZE, &limit);
+  std::signal(SIGXFSZ, m_previousHandler);
+}
+
+std::vector<std::string> folderEntries(const std::filesystem::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
 }  // namespace fct::test

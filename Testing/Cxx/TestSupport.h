@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace fct::test {
 
@@ -33,6 +34,26 @@ struct ProcessResult {
 ProcessResult runCommand(const std::string& commandLine);
 /// Runs `fluoroct` with the given argument string (shell-quoted by the caller) and captures its output.
 ProcessResult runCli(const std::string& arguments);
+/// Runs `fluoroct` like runCli in a child process whose files may not grow beyond `maxFileBytes` (RLIMIT_FSIZE, with
+/// SIGXFSZ ignored, so a write past the limit fails with EFBIG like on a full disk).
+ProcessResult runCliWithFileSizeLimit(const std::string& arguments, long maxFileBytes);
+
+/// While alive, this process cannot write files larger than `maxFileBytes` (soft RLIMIT_FSIZE, SIGXFSZ ignored): every
+/// write past the limit fails with EFBIG ("File too large"), as on a full disk. Restores both on destruction.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(long maxFileBytes);
+  ~FileSizeLimit();
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  unsigned long long m_previousSoftLimit;
+  void (*m_previousHandler)(int);
+};
+
+/// The names of the entries of `folder`, sorted (to check that a failed write left no temporary file behind).
+std::vector<std::string> folderEntries(const std::filesystem::path& folder);
 
 }  // namespace fct::test
 

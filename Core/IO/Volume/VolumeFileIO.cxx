@@ -1,11 +1,9 @@
 #include "IO/Volume/VolumeFileIO.h"
 
-#include <fmt/core.h>
-#include <unistd.h>
+#include "Base/AtomicFile.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
+#include <fmt/core.h>
+
 #include <span>
 #include <system_error>
 
@@ -24,33 +22,9 @@ std::string extensionOf(const std::filesystem::path& path) {
   return TextHeader::lower(path.extension().string());
 }
 
-/// Writes header then the voxels to a temporary file beside `path` and renames it into place.
+/// Writes header then the voxels with AtomicFile.
 Status writeAtomically(const std::filesystem::path& path, const std::string& header, std::span<const float> voxels) {
-  const std::filesystem::path parent = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
-  std::error_code ec;
-  if (!std::filesystem::is_directory(parent, ec)) {
-    return fail(fmt::format("cannot write '{}': the folder '{}' does not exist; create it first", path.string(),
-                            parent.string()));
-  }
-  const std::filesystem::path temp = parent / fmt::format(".{}.tmp-{}", path.filename().string(), ::getpid());
-  std::FILE* file = std::fopen(temp.c_str(), "wb");
-  if (!file) {
-    return fail(fmt::format("cannot write '{}': {}; choose a writable folder", path.string(), std::strerror(errno)));
-  }
-  bool ok = std::fwrite(header.data(), 1, header.size(), file) == header.size() &&
-            std::fwrite(voxels.data(), sizeof(float), voxels.size(), file) == voxels.size();
-  const int writeErrno = errno;
-  ok = (std::fclose(file) == 0) && ok;
-  if (!ok) {
-    std::filesystem::remove(temp, ec);
-    return fail(fmt::format("writing '{}' failed: {}; check free disk space", path.string(), std::strerror(writeErrno)));
-  }
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    return fail(fmt::format("cannot move the finished file into place at '{}': {}", path.string(), ec.message()));
-  }
-  return Ok{};
+  return AtomicFile::write(path, {header, AtomicFile::bytesOf(voxels.data(), voxels.size())});
 }
 
 }  // namespace

@@ -1,14 +1,15 @@
 #include "IO/Xray/ImageFileWriter.h"
 
+#include "Base/AtomicFile.h"
+
 #include <fmt/core.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <functional>
+#include <string>
+#include <vector>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -25,49 +26,30 @@ Status checkImage(const FloatImage& image, const std::filesystem::path& path) {
   return Ok{};
 }
 
-/// Runs `write` on a temporary file beside `path` (same extension, so format-by-extension encoders work), then
-/// renames it into place; removes the temporary file on failure.
-Status writeAtomically(const std::filesystem::path& path, const std::function<Status(const std::filesystem::path&)>& write) {
-  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  std::error_code ec;
-  if (!std::filesystem::is_directory(folder, ec)) {
-    return fail(fmt::format("cannot write '{}': folder '{}' does not exist", path.string(), folder.string()));
-  }
-  const std::filesystem::path temp =
-      folder / fmt::format(".{}.tmp{}{}", path.stem().string(), ::getpid(), path.extension().string());
-  Status status = Ok{};
-  try {
-    status = write(temp);
-  } catch (const cv::Exception& e) {
-    status = fail(fmt::format("cannot write '{}': {}", path.string(), e.what()));
-  }
-  if (status) {
-    std::filesystem::rename(temp, path, ec);
-    if (ec) status = fail(fmt::format("cannot write '{}': {}", path.string(), ec.message()));
-  }
-  if (!status) std::filesystem::remove(temp, ec);
-  return status;
-}
-
-Status writeBinary(const std::filesystem::path& temp, const std::filesystem::path& path, const std::string& header,
-                   const FloatImage& image, bool bottomUp) {
-  std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-  out << header;
-  const auto rowBytes = static_cast<std::streamsize>(sizeof(float) * static_cast<std::size_t>(image.cols));
+/// The pixel bytes after `header`, rows top to bottom or (PFM) bottom to top.
+std::string rawBytes(const std::string& header, const FloatImage& image, bool bottomUp) {
+  std::string bytes = header;
+  const std::size_t rowBytes = sizeof(float) * static_cast<std::size_t>(image.cols);
+  bytes.reserve(header.size() + rowBytes * static_cast<std::size_t>(image.rows));
   for (int r = 0; r < image.rows; ++r) {
     const int row = bottomUp ? image.rows - 1 - r : r;
-    out.write(reinterpret_cast<const char*>(image.pixels.data() + static_cast<std::size_t>(row) * image.cols), rowBytes);
+    bytes.append(reinterpret_cast<const char*>(image.pixels.data() + static_cast<std::size_t>(row) * image.cols),
+                 rowBytes);
   }
-  out.close();
-  if (!out) return fail(fmt::format("cannot write '{}': disk full or not writable", path.string()));
-  return Ok{};
+  return bytes;
 }
 
-Status imwriteStatus(const std::filesystem::path& temp, const std::filesystem::path& path, const cv::Mat& mat) {
-  if (!cv::imwrite(temp.string(), mat)) {
-    return fail(fmt::format("cannot write '{}': OpenCV's encoder refused it (folder not writable?)", path.string()));
+/// Encodes `mat` in the format of `path`'s extension in memory, then writes it with AtomicFile.
+Status encodeAndWrite(const std::filesystem::path& path, const cv::Mat& mat) {
+  std::vector<unsigned char> encoded;
+  try {
+    if (!cv::imencode(path.extension().string(), mat, encoded)) {
+      return fail(fmt::format("cannot write '{}': OpenCV's encoder refused the image", path.string()));
+    }
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("cannot write '{}': {}", path.string(), e.what()));
   }
-  return Ok{};
+  return AtomicFile::write(path, {AtomicFile::bytesOf(encoded.data(), encoded.size())});
 }
 
 cv::Mat wrap(const FloatImage& image) {
@@ -82,14 +64,12 @@ static_assert(sizeof(float) == 4 && std::endian::native == std::endian::little,
 Status ImageFileWriter::writePfm(const FloatImage& image, const std::filesystem::path& path) {
   if (Status ok = checkImage(image, path); !ok) return ok;
   const std::string header = fmt::format("Pf\n{} {}\n-1.0\n", image.cols, image.rows);  // negative scale: little endian
-  return writeAtomically(path, [&](const std::filesystem::path& temp) {
-    return writeBinary(temp, path, header, image, /*bottomUp=*/true);
-  });
+  return AtomicFile::write(path, {rawBytes(header, image, /*bottomUp=*/true)});
 }
 
 Status ImageFileWriter::writeTiff(const FloatImage& image, const std::filesystem::path& path) {
   if (Status ok = checkImage(image, path); !ok) return ok;
-  return writeAtomically(path, [&](const std::filesystem::path& temp) { return imwriteStatus(temp, path, wrap(image)); });
+  return encodeAndWrite(path, wrap(image));
 }
 
 Status ImageFileWriter::writePng16(const FloatImage& image, const std::filesystem::path& path, float windowMin,
@@ -109,7 +89,7 @@ Status ImageFileWriter::writePng16(const FloatImage& image, const std::filesyste
       out[c] = static_cast<std::uint16_t>(std::lround(mapped));
     }
   }
-  return writeAtomically(path, [&](const std::filesystem::path& temp) { return imwriteStatus(temp, path, png); });
+  return encodeAndWrite(path, png);
 }
 
 Status ImageFileWriter::writePngRgb(const RgbImage& image, const std::filesystem::path& path) {
@@ -120,7 +100,7 @@ Status ImageFileWriter::writePngRgb(const RgbImage& image, const std::filesystem
   cv::Mat bgr;
   cv::cvtColor(cv::Mat(image.rows, image.cols, CV_8UC3, const_cast<std::uint8_t*>(image.pixels.data())), bgr,
                cv::COLOR_RGB2BGR);
-  return writeAtomically(path, [&](const std::filesystem::path& temp) { return imwriteStatus(temp, path, bgr); });
+  return encodeAndWrite(path, bgr);
 }
 
 Status ImageFileWriter::writeNrrd2d(const FloatImage& image, const std::filesystem::path& path,
@@ -134,9 +114,7 @@ Status ImageFileWriter::writeNrrd2d(const FloatImage& image, const std::filesyst
       "NRRD0004\n# written by FluoroCT\ntype: float\ndimension: 2\nsizes: {} {}\nspacings: {} {}\nendian: little\n"
       "encoding: raw\n\n",
       image.cols, image.rows, pixelSpacing_mm.x(), pixelSpacing_mm.y());
-  return writeAtomically(path, [&](const std::filesystem::path& temp) {
-    return writeBinary(temp, path, header, image, /*bottomUp=*/false);
-  });
+  return AtomicFile::write(path, {rawBytes(header, image, /*bottomUp=*/false)});
 }
 
 }  // namespace fct

@@ -1,6 +1,6 @@
 #pragma once
-// ImageFileWriter: writes FloatImages (DRRs, prepared X-rays) to files. Every write goes to a temporary file in the
-// target folder and is renamed into place, so a failed write never leaves a half-written file.
+// ImageFileWriter: writes FloatImages (DRRs, prepared X-rays) to files. Every image is encoded in memory and written with
+// AtomicFile, so a failed write never leaves a half-written file.
 
 #include <Eigen/Core>
 
