@@ -225,6 +225,10 @@ TEST(VolumeFileIO, RejectsMissingUnknownTruncatedAndMalformedFiles) {
   EXPECT_NE(fct::VolumeFileIO::read(dir / "short.nii").error().find("truncated"), std::string::npos);
   writeFile(dir / "header_only.nii", tinyNifti({4, 3, 2}, {1, 1, 1}, 1.0f, {0, 0, 0}, {0, 0, 0}).substr(0, 200));
   EXPECT_NE(fct::VolumeFileIO::read(dir / "header_only.nii").error().find("truncated"), std::string::npos);
+  std::string farOffset = tinyNifti({4, 3, 2}, {1, 1, 1}, 1.0f, {0, 0, 0}, {0, 0, 0});
+  put<float>(farOffset, 108, 6.7e31f);  // vox_offset far past the end (found by fuzzing: an out-of-range cast)
+  writeFile(dir / "far_offset.nii", farOffset);
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "far_offset.nii").error().find("beyond the file's"), std::string::npos);
   const std::string gz = gzipBytes(tinyNifti({40, 30, 20}, {1, 1, 1}, 1.0f, {0, 0, 0}, {0, 0, 0}));
   writeFile(dir / "cut.nii.gz", gz.substr(0, gz.size() / 2));
   EXPECT_FALSE(fct::VolumeFileIO::read(dir / "cut.nii.gz").ok());
