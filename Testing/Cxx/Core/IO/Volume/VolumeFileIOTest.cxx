@@ -239,6 +239,11 @@ TEST(VolumeFileIO, RejectsMissingUnknownTruncatedAndMalformedFiles) {
 
   writeFile(dir / "zero.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 0 5 5\nencoding: raw\n\n");
   EXPECT_NE(fct::VolumeFileIO::read(dir / "zero.nrrd").error().find("must be positive"), std::string::npos);
+  writeFile(dir / "huge.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 7.7e29 5 5\nencoding: raw\n\n");
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "huge.nrrd").error().find("whole number of voxels"), std::string::npos);
+  writeFile(dir / "fraction.mha", "ObjectType = Image\nNDims = 3\nElementSpacing = 1 1 1\nDimSize = 1.5 1 1\n"
+                                  "ElementType = MET_FLOAT\nElementDataFile = LOCAL\nabcd");
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "fraction.mha").error().find("DimSize"), std::string::npos);
   writeFile(dir / "nan.mha", "ObjectType = Image\nNDims = 3\nElementSpacing = nan 1 1\nDimSize = 1 1 1\n"
                              "ElementType = MET_FLOAT\nElementDataFile = LOCAL\nabcd");
   EXPECT_NE(fct::VolumeFileIO::read(dir / "nan.mha").error().find("ElementSpacing"), std::string::npos);
