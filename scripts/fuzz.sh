@@ -140,9 +140,12 @@ for t in "${targets[@]}"; do
   ((seconds > 0)) && limits+=(-max_total_time="$seconds")
   echo "fuzz: $t for ${seconds}s (runs $runs) ..."
   set +e
-  QT_QPA_PLATFORM=offscreen FCT_FUZZ_TARGET=$t nice -n 19 "$program" "${limits[@]}" \
+  scratch=/dev/shm/fluoroct-fuzz-$$-$t  # the loaders' RAM folder; a crash leaves it behind, so it is removed here
+  [[ -d /dev/shm ]] || scratch="$tmp/scratch-$t"
+  QT_QPA_PLATFORM=offscreen FCT_FUZZ_TARGET=$t FCT_FUZZ_SCRATCH=$scratch nice -n 19 "$program" "${limits[@]}" \
     -artifact_prefix="$work/crashes/$t/" "$work/corpus/$t" "$seeds/$t" >"$log" 2>&1
   status=$?
+  rm -rf "$scratch"
   set -e
   executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   kept=$(find "$work/crashes/$t" -type f | wc -l)

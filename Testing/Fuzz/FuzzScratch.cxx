@@ -76,7 +76,8 @@ fs::path makeFolder() {
   const fs::path shm = "/dev/shm";
   std::error_code ec;
   const fs::path base = fs::is_directory(shm, ec) ? shm : fs::temp_directory_path();
-  const fs::path folder = base / ("fluoroct-fuzz-" + std::to_string(::getpid()));
+  const char* named = std::getenv("FCT_FUZZ_SCRATCH");  // scripts/fuzz.sh names it, to remove it after a crash
+  const fs::path folder = named && *named ? fs::path(named) : base / ("fluoroct-fuzz-" + std::to_string(::getpid()));
   fs::remove_all(folder, ec);
   if (!fs::create_directories(folder, ec)) abortWith("cannot create the scratch folder " + folder.string());
   writeFixtureCt(folder / FuzzScratch::kCtFile);
@@ -95,12 +96,9 @@ void removeFolder() {
 }  // namespace
 
 const fs::path& FuzzScratch::folder() {
-  static const fs::path folder = [] {
-    fs::path made = makeFolder();
-    std::atexit(removeFolder);
-    return made;
-  }();
-  g_folder = &folder;
+  static const fs::path folder = makeFolder();
+  // Registered after `folder` is made, so that it runs before `folder` is destroyed.
+  [[maybe_unused]] static const bool removedAtExit = (g_folder = &folder, std::atexit(removeFolder) == 0);
   return folder;
 }
 

@@ -19,8 +19,8 @@ class FuzzScratch {
   static constexpr const char* kCtLandmarkFile = "ct.mrk.json";
   static constexpr const char* kImageLandmarkFile = "clicks.json";
 
-  /// The scratch folder of this process (created on first use with its fixtures, removed at exit); aborts with a
-  /// message when it cannot be made, since no input could then be tried.
+  /// The scratch folder of this process ($FCT_FUZZ_SCRATCH if set, else /dev/shm/fluoroct-fuzz-<pid>; created on
+  /// first use with its fixtures, removed at a normal exit); aborts with a message when it cannot be made.
   static const std::filesystem::path& folder();
   /// Writes `size` bytes to folder()/name (replacing it) and returns the path; aborts when the write fails.
   static std::filesystem::path write(const std::string& name, const std::uint8_t* data, std::size_t size);
