@@ -17,6 +17,8 @@ FCT_PACKAGES=(
 )
 # Opt-in: a one-node Slurm cluster for trying study-slurm.sbatch, installed only by scripts/slurm-local.sh.
 FCT_SLURM_PACKAGES=(slurm-wlm munge)
+# Opt-in: libFuzzer (clang) and DCMTK's tools (seeds in every transfer syntax), installed only by scripts/fuzz.sh.
+FCT_FUZZ_PACKAGES=(clang-14 libfuzzer-14-dev dcmtk)
 
 # Installs those of the given packages (default: FCT_PACKAGES) that are missing.
 fct_install_packages() {

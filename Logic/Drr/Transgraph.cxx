@@ -193,7 +193,8 @@ Result<Transgraph> Transgraph::build(const Volume& ct, const Camera& view, const
   const auto start = std::chrono::steady_clock::now();
 
   std::vector<float> table(layout.rayCount());
-  const auto [n_s, n_t, n_ds, n_dt] = layout.counts;
+  // Named copies, not a structured binding: the lambda below captures them (clang 14 cannot capture bindings).
+  const int n_s = layout.counts[0], n_t = layout.counts[1], n_ds = layout.counts[2], n_dt = layout.counts[3];
   const std::size_t rows = static_cast<std::size_t>(n_s) * n_t;
   const std::size_t raysPerRow = static_cast<std::size_t>(n_ds) * n_dt;
   std::atomic<std::size_t> rowsDone{0};

@@ -150,6 +150,19 @@ Result<Volume> SliceStack::resampled(double sliceSpacing_mm, float outside_value
     return fail(fmt::format("resampled grid {}x{}x{} at {} mm slice spacing is too large; choose a larger spacing", ni,
                             nj, nk, sliceSpacing_mm));
   }
+  // Tilt and gaps enlarge a real series' grid a few times at most; far more means implausible slice positions (a
+  // damaged file) or a spacing far below the slice gaps, and would only fill memory with empty voxels.
+  constexpr double kMaxGrowth = 64.0;
+  const double stackVoxels = static_cast<double>(m_size_px.x()) * m_size_px.y() * count;
+  if (ni * nj * nk > kMaxGrowth * stackVoxels) {
+    return fail(fmt::format("resampled grid {}x{}x{} at {} mm slice spacing would hold {:.0f} times the {} slices' "
+                            "voxels; the slice origins spread {:.1f} mm in-plane and {:.1f} mm along the normal, "
+                            "which looks damaged, or the spacing is far too small; check ImagePositionPatient or "
+                            "choose a larger spacing",
+                            ni, nj, nk, sliceSpacing_mm, ni * nj * nk / stackVoxels, count,
+                            std::hypot(aMax - aMin - (m_size_px.x() - 1) * du, bMax - bMin - (m_size_px.y() - 1) * dv),
+                            w.back()));
+  }
   Eigen::Matrix3d direction;
   direction << m_rowCosine_lps, m_columnCosine_lps, normal;
   const Eigen::Vector3d origin = first + aMin * m_rowCosine_lps + bMin * m_columnCosine_lps;

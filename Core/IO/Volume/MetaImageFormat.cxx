@@ -116,10 +116,9 @@ Result<Volume> MetaImageFormat::read(const std::filesystem::path& path) {
   }
   const auto dimText = field({"DimSize"});
   if (!dimText) return fail(fmt::format("{} lacks the DimSize field", source));
-  auto dimValues = TextHeader::numbers(*dimText, 3, "DimSize");
+  auto dimValues = TextHeader::sizes(*dimText, "DimSize");
   if (!dimValues.ok()) return fail(fmt::format("{}: {}", source, dimValues.error()));
-  const Eigen::Vector3i dims(static_cast<int>(dimValues.value()[0]), static_cast<int>(dimValues.value()[1]),
-                             static_cast<int>(dimValues.value()[2]));
+  const Eigen::Vector3i dims(dimValues.value()[0], dimValues.value()[1], dimValues.value()[2]);
   auto count = VoxelCodec::voxelCount(dims, source);
   if (!count.ok()) return fail(count.error());
 

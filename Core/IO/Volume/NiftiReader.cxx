@@ -108,6 +108,10 @@ Result<Volume> NiftiReader::read(const std::filesystem::path& path) {
   if (!std::isfinite(voxOffset) || voxOffset < static_cast<double>(kHeaderBytes)) {
     return fail(fmt::format("{} has an invalid vox_offset {}", source, voxOffset));
   }
+  if (voxOffset > static_cast<double>(bytes.size())) {
+    return fail(fmt::format("{} is truncated or damaged: its voxel data would start at byte {:g} (vox_offset), beyond "
+                            "the file's {} bytes", source, voxOffset, bytes.size()));
+  }
   const std::size_t dataStart = static_cast<std::size_t>(voxOffset);
   const std::size_t dataBytes = count.value() * VoxelCodec::bytesPerScalar(*type);
   if (bytes.size() < dataStart || bytes.size() - dataStart < dataBytes) {

@@ -90,10 +90,9 @@ Result<Volume> NrrdFormat::read(const std::filesystem::path& path) {
   }
   const auto sizesText = field("sizes");
   if (!sizesText) return fail(fmt::format("{} lacks the 'sizes' field", source));
-  auto sizes = TextHeader::numbers(*sizesText, 3, "sizes");
+  auto sizes = TextHeader::sizes(*sizesText, "sizes");
   if (!sizes.ok()) return fail(fmt::format("{}: {}", source, sizes.error()));
-  const Eigen::Vector3i dims(static_cast<int>(sizes.value()[0]), static_cast<int>(sizes.value()[1]),
-                             static_cast<int>(sizes.value()[2]));
+  const Eigen::Vector3i dims(sizes.value()[0], sizes.value()[1], sizes.value()[2]);
   auto count = VoxelCodec::voxelCount(dims, source);
   if (!count.ok()) return fail(count.error());
 

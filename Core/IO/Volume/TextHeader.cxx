@@ -5,6 +5,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 namespace fct {
 
@@ -48,6 +49,21 @@ Result<std::vector<double>> TextHeader::numbers(std::string_view text, std::size
                             trim(text)));
   }
   return values;
+}
+
+Result<std::array<int, 3>> TextHeader::sizes(std::string_view text, std::string_view field) {
+  auto values = numbers(text, 3, field);
+  if (!values.ok()) return fail(values.error());
+  std::array<int, 3> sizes{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double value = values.value()[a];
+    if (value != std::floor(value) || std::abs(value) > std::numeric_limits<int>::max()) {
+      return fail(fmt::format("header field '{}' has {:g} where a whole number of voxels (below 2^31) is expected",
+                              field, value));
+    }
+    sizes[a] = static_cast<int>(value);
+  }
+  return sizes;
 }
 
 }  // namespace fct

@@ -136,3 +136,15 @@ TEST(SliceStack, RejectsBadStacks) {
   ASSERT_FALSE(notRegular.ok());
   EXPECT_NE(notRegular.error().find("1.000–2.000 mm"), std::string::npos) << notRegular.error();
 }
+
+TEST(SliceStack, RefusesAGridFarLargerThanItsSlicesAsImplausiblePositions) {
+  const Vector3d row(1, 0, 0), col(0, 1, 0);
+  // A slice origin 10 m off in-plane (a damaged ImagePositionPatient, found by fuzzing) would need a grid of ~10^8
+  // voxels for 60 pixels of data.
+  auto stack = fct::SliceStack::create({5, 4}, {0.8, 0.5}, row, col,
+                                       {Vector3d(0, 0, 0), Vector3d(10000, 0, 1), Vector3d(0, 0, 3)});
+  ASSERT_TRUE(stack.ok()) << stack.error();
+  const auto resampled = stack.value().resampled(1.0, -1000.0f);
+  ASSERT_FALSE(resampled.ok());
+  EXPECT_NE(resampled.error().find("looks damaged"), std::string::npos) << resampled.error();
+}

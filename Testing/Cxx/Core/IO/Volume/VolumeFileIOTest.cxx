@@ -225,6 +225,10 @@ TEST(VolumeFileIO, RejectsMissingUnknownTruncatedAndMalformedFiles) {
   EXPECT_NE(fct::VolumeFileIO::read(dir / "short.nii").error().find("truncated"), std::string::npos);
   writeFile(dir / "header_only.nii", tinyNifti({4, 3, 2}, {1, 1, 1}, 1.0f, {0, 0, 0}, {0, 0, 0}).substr(0, 200));
   EXPECT_NE(fct::VolumeFileIO::read(dir / "header_only.nii").error().find("truncated"), std::string::npos);
+  std::string farOffset = tinyNifti({4, 3, 2}, {1, 1, 1}, 1.0f, {0, 0, 0}, {0, 0, 0});
+  put<float>(farOffset, 108, 6.7e31f);  // vox_offset far past the end (found by fuzzing: an out-of-range cast)
+  writeFile(dir / "far_offset.nii", farOffset);
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "far_offset.nii").error().find("beyond the file's"), std::string::npos);
   const std::string gz = gzipBytes(tinyNifti({40, 30, 20}, {1, 1, 1}, 1.0f, {0, 0, 0}, {0, 0, 0}));
   writeFile(dir / "cut.nii.gz", gz.substr(0, gz.size() / 2));
   EXPECT_FALSE(fct::VolumeFileIO::read(dir / "cut.nii.gz").ok());
@@ -235,6 +239,11 @@ TEST(VolumeFileIO, RejectsMissingUnknownTruncatedAndMalformedFiles) {
 
   writeFile(dir / "zero.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 0 5 5\nencoding: raw\n\n");
   EXPECT_NE(fct::VolumeFileIO::read(dir / "zero.nrrd").error().find("must be positive"), std::string::npos);
+  writeFile(dir / "huge.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 7.7e29 5 5\nencoding: raw\n\n");
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "huge.nrrd").error().find("whole number of voxels"), std::string::npos);
+  writeFile(dir / "fraction.mha", "ObjectType = Image\nNDims = 3\nElementSpacing = 1 1 1\nDimSize = 1.5 1 1\n"
+                                  "ElementType = MET_FLOAT\nElementDataFile = LOCAL\nabcd");
+  EXPECT_NE(fct::VolumeFileIO::read(dir / "fraction.mha").error().find("DimSize"), std::string::npos);
   writeFile(dir / "nan.mha", "ObjectType = Image\nNDims = 3\nElementSpacing = nan 1 1\nDimSize = 1 1 1\n"
                              "ElementType = MET_FLOAT\nElementDataFile = LOCAL\nabcd");
   EXPECT_NE(fct::VolumeFileIO::read(dir / "nan.mha").error().find("ElementSpacing"), std::string::npos);

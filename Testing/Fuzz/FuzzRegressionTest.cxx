@@ -1,0 +1,83 @@
+// Replays, through the fuzz entry points, every kept input of Testing/Fuzz/regressions/<target>/ (inputs that once
+// crashed a loader, minimized) and Testing/Fuzz/seeds/<target>/ (tiny hand-made seeds), and the seeds the project's
+// writers make (FuzzSeedWriter): none may crash, hang or break a loader's contract (that aborts the program).
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "FuzzSeedWriter.h"
+#include "FuzzStudioTargets.h"
+#include "FuzzTargets.h"
+#include "TestSupport.h"
+
+namespace fs = std::filesystem;
+using fct::fuzz::FuzzTarget;
+
+namespace {
+
+std::vector<FuzzTarget> allTargets() {
+  std::vector<FuzzTarget> targets = fct::fuzz::loaderTargets();
+  const auto& studio = fct::fuzz::studioTargets();
+  targets.insert(targets.end(), studio.begin(), studio.end());
+  return targets;
+}
+
+/// The seeds the project's writers make, written once per test program.
+const fs::path& writtenSeeds() {
+  static const fs::path root = [] {
+    const fs::path folder = fct::test::scratchDir().parent_path() / "fuzz_seeds";
+    std::error_code ec;
+    fs::remove_all(folder, ec);
+    const fct::Status loaders = fct::fuzz::writeLoaderSeeds(folder);
+    const fct::Status studio = fct::fuzz::writeStudioSeeds(folder);
+    EXPECT_TRUE(loaders.ok()) << loaders.error();
+    EXPECT_TRUE(studio.ok()) << studio.error();
+    return folder;
+  }();
+  return root;
+}
+
+std::vector<fs::path> inputsOf(const std::string& target) {
+  std::vector<fs::path> inputs;
+  for (const fs::path& root : {fs::path(FCT_FUZZ_DIR) / "regressions", fs::path(FCT_FUZZ_DIR) / "seeds", writtenSeeds()}) {
+    std::error_code ec;
+    if (!fs::is_directory(root / target, ec)) continue;
+    for (const auto& entry : fs::directory_iterator(root / target)) {
+      if (entry.is_regular_file()) inputs.push_back(entry.path());
+    }
+  }
+  return inputs;
+}
+
+}  // namespace
+
+namespace fct::fuzz {
+/// Prints a target by its name in test names and messages.
+void PrintTo(const FuzzTarget& target, std::ostream* out) { *out << target.name; }
+}  // namespace fct::fuzz
+
+namespace {
+
+class FuzzRegressions : public ::testing::TestWithParam<FuzzTarget> {};
+
+}  // namespace
+
+TEST_P(FuzzRegressions, ReplaysEveryKeptInputWithoutACrash) {
+  const FuzzTarget target = GetParam();
+  const std::vector<fs::path> inputs = inputsOf(target.name);
+  ASSERT_FALSE(inputs.empty()) << "no regression or seed input for the fuzz target '" << target.name
+                               << "'; add one under Testing/Fuzz/seeds/" << target.name << "/";
+  for (const fs::path& input : inputs) {
+    std::ifstream in(input, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(target.run(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), 0) << input;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Targets, FuzzRegressions, ::testing::ValuesIn(allTargets()),
+                         [](const ::testing::TestParamInfo<FuzzTarget>& info) { return std::string(info.param.name); });

@@ -1,0 +1,147 @@
+#include "FuzzSeedWriter.h"
+
+#include <fmt/core.h>
+
+#include <Eigen/Geometry>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "FuzzScratch.h"
+#include "FuzzTargets.h"
+#include "Drr/TransgraphCache.h"
+#include "IO/Project/DewarpFile.h"
+#include "IO/Project/ItkTransformFile.h"
+#include "IO/Project/PoseFile.h"
+#include "IO/Volume/MetaImageFormat.h"
+#include "IO/Volume/NrrdFormat.h"
+#include "IO/Volume/VolumeFileIO.h"
+#include "IO/Xray/ImageFileWriter.h"
+#include "IO/Xray/XrayLoader.h"
+#include "Registration/RegistrationSchedule.h"
+
+namespace fct::fuzz {
+namespace fs = std::filesystem;
+
+namespace {
+
+Status writeBytes(const fs::path& path, const std::string& bytes) {
+  std::error_code ec;
+  fs::create_directories(path.parent_path(), ec);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << bytes;
+  out.close();
+  if (!out) return fail(fmt::format("cannot write the seed {}", path.string()));
+  return Ok{};
+}
+
+Status copySeed(const fs::path& from, const fs::path& to) {
+  std::error_code ec;
+  fs::create_directories(to.parent_path(), ec);
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+  if (ec) return fail(fmt::format("cannot copy the seed {} to {}: {}", from.string(), to.string(), ec.message()));
+  return Ok{};
+}
+
+std::string voxelBytes(const Volume& volume) {
+  const auto& voxels = volume.voxels();
+  return std::string(reinterpret_cast<const char*>(voxels.data()), voxels.size() * sizeof(float));
+}
+
+/// A header + NUL + data seed of the .nhdr / .mhd targets.
+std::string detached(const std::string& header, const Volume& volume) {
+  return header + std::string(1, '\0') + voxelBytes(volume);
+}
+
+Status writeVolumeSeeds(const fs::path& root) {
+  const fs::path scratch = FuzzScratch::folder();
+  auto ct = VolumeFileIO::read(scratch / FuzzScratch::kCtFile);
+  if (!ct) return fail(ct.error());
+  const Volume& volume = ct.value();
+  for (const auto& [target, file] : std::vector<std::pair<std::string, std::string>>{{"nrrd", "ct.nrrd"},
+                                                                                    {"mha", "ct.mha"}}) {
+    if (Status written = VolumeFileIO::write(volume, root / target / file); !written) return written;
+  }
+  std::string nhdr = NrrdFormat::header(volume);
+  nhdr.insert(nhdr.size() - 1, "data file: fuzz.raw\n");  // before the closing blank line
+  if (Status written = writeBytes(root / "nhdr" / "ct.nhdr", detached(nhdr, volume)); !written) return written;
+  return writeBytes(root / "mhd" / "ct.mhd", detached(MetaImageFormat::header(volume, "fuzz.raw"), volume));
+}
+
+Status writeImageSeeds(const fs::path& root) {
+  const fs::path scratch = FuzzScratch::folder();
+  if (Status copied = copySeed(scratch / "ap.png", root / "xray_png" / "ap.png"); !copied) return copied;
+  auto image = XrayLoader::load(scratch / "lateral.png");
+  if (!image) return fail(image.error());
+  const FloatImage pixels{image.value().cols, image.value().rows, image.value().pixels};
+  if (Status written = ImageFileWriter::writeTiff(pixels, root / "xray_tiff" / "lateral.tif"); !written) return written;
+  return ImageFileWriter::writePng16(pixels, root / "xray_png" / "lateral_window.png", 1000.0f, 40000.0f);
+}
+
+Status writeProjectSeeds(const fs::path& root) {
+  const fs::path scratch = FuzzScratch::folder();
+  for (const auto& [target, file] : std::vector<std::pair<std::string, std::string>>{
+           {"view", FuzzScratch::kViewFile},
+           {"landmark", FuzzScratch::kCtLandmarkFile},
+           {"landmark", FuzzScratch::kImageLandmarkFile}}) {
+    if (Status copied = copySeed(scratch / file, root / target / file); !copied) return copied;
+  }
+  for (const char* method : {"reprojection", "triangulation"}) {
+    const std::string pairs = fmt::format(R"({{"ct": "{}", "image": "{}", "method": "{}"}})",
+                                          FuzzScratch::kCtLandmarkFile, FuzzScratch::kImageLandmarkFile, method);
+    if (Status written = writeBytes(root / "landmark_pair" / (std::string(method) + ".json"), pairs); !written) {
+      return written;
+    }
+  }
+  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();
+  T_world_from_ct.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T_world_from_ct.translation() = Eigen::Vector3d(5.0, -4.0, 6.0);
+  if (Status written = PoseFile::write(T_world_from_ct, root / "pose" / "pose.json"); !written) return written;
+  if (Status written = ItkTransformFile::write(T_world_from_ct, root / "tfm" / "pose.tfm"); !written) return written;
+  for (const std::string& name : RegistrationSchedule::builtinNames()) {
+    auto schedule = RegistrationSchedule::builtin(name);
+    if (!schedule) return fail(schedule.error());
+    if (Status written = writeBytes(root / "preset" / (name + ".json"), schedule.value().toJson().dump(2)); !written) {
+      return written;
+    }
+  }
+  return Ok{};
+}
+
+Status writeBinarySeeds(const fs::path& root) {
+  const TransgraphLayout layout = transgraphLayout();
+  std::vector<float> table(layout.rayCount());
+  for (std::size_t n = 0; n < table.size(); ++n) table[n] = 0.5f * static_cast<float>(n);
+  if (Status saved = TransgraphCache::save(root / "transgraph_cache" / "table.fctg", kTransgraphKey, layout, table);
+      !saved) {
+    return saved;
+  }
+  const int degree = 3;
+  const auto termCount = static_cast<Eigen::Index>(DewarpField::terms(degree).size());
+  Eigen::VectorXd colCoefficients = Eigen::VectorXd::Zero(termCount), rowCoefficients = colCoefficients;
+  colCoefficients[1] = 0.4;
+  rowCoefficients[2] = -0.3;
+  auto field = DewarpField::create(16, 12, degree, colCoefficients, rowCoefficients);
+  if (!field) return fail(field.error());
+  DewarpFileContents contents{field.value(), {}};
+  contents.calibration.gridImage = "grid.png";
+  contents.calibration.pitch_mm = 10.0;
+  contents.calibration.beadCount = 12;
+  return DewarpFile::write(contents, root / "dewarp" / "field.dewarp.json");
+}
+
+}  // namespace
+
+Status writeLoaderSeeds(const fs::path& root) {
+  for (const FuzzTarget& target : loaderTargets()) {
+    std::error_code ec;
+    fs::create_directories(root / target.name, ec);
+    if (ec) return fail(fmt::format("cannot create the seed folder {}: {}", (root / target.name).string(), ec.message()));
+  }
+  for (Status (*write)(const fs::path&) : {writeVolumeSeeds, writeImageSeeds, writeProjectSeeds, writeBinarySeeds}) {
+    if (Status written = write(root); !written) return written;
+  }
+  return Ok{};
+}
+
+}  // namespace fct::fuzz
