@@ -8,7 +8,7 @@
 #     head phantom, with the NCC between the two programs' images (Testing/Benchmarks/DrrBenchmark --whole-process).
 # With --scaling it prints instead the default preset's time and peak memory against detector size, view count and
 # CT size.
-# Usage: scripts/benchmark.sh [--starts N] [--baseline-starts N] [--drr-repeats N] [--no-drr] [--no-registration]
+# Usage: scripts/benchmark.sh [--starts N] [--baseline-starts N (0: no baseline)] [--drr-repeats N] [--no-drr] [--no-registration]
 #                             [--scaling] [--work DIR (kept, with the simulated cases)]
 # Environment: BUILD_DIR (default build), FLUOROCT_DATA_DIR (default ../shared/data beside the source tree).
 set -euo pipefail
@@ -143,7 +143,9 @@ if ((REGISTRATION)); then
     make_case "$name" "$ct" 512 512 0.45 3
     run_config "$name" "$ct" default "$STARTS"
     run_config "$name" "$ct" paper "$STARTS" --preset paper
-    run_config "$name" "$ct" baseline "$BASELINE_STARTS" --preset "$ROOT/Testing/Benchmarks/baseline.json"
+    if ((BASELINE_STARTS > 0)); then
+      run_config "$name" "$ct" baseline "$BASELINE_STARTS" --preset "$ROOT/Testing/Benchmarks/baseline.json"
+    fi
   done
   echo
   echo "| case | preset | starts | median time | median process CPU | median DRRs | median error | peak memory |"
@@ -153,7 +155,7 @@ if ((REGISTRATION)); then
     name="${entry%%:*}"
     [[ -n "${MEDIAN_TIME[$name/default]:-}" ]] || continue
     awk -v n="$name" -v d="${MEDIAN_TIME[$name/default]}" -v p="${MEDIAN_TIME[$name/paper]}" \
-        -v b="${MEDIAN_TIME[$name/baseline]}" \
+        -v b="${MEDIAN_TIME[$name/baseline]:-nan}" \
         -v ed="${MEDIAN_ERROR[$name/default]}" -v ep="${MEDIAN_ERROR[$name/paper]}" \
         'BEGIN {printf "ratio paper/default time %s: %.2f\nratio baseline/default time %s: %.2f\n", n, p/d, n, b/d;
                 printf "error default-paper %s: %+.3f mm (target <= +0.05)\n", n, ed-ep}'
