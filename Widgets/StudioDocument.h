@@ -46,7 +46,7 @@ struct RoiParameters {
 
 /// What the Register step runs.
 struct StudioRegistrationOptions {
-  std::string preset = "fast";       ///< built-in preset name ("fast", "paper") or a preset JSON file
+  std::string preset = RegistrationSchedule::kDefaultPreset;  ///< built-in preset name or a preset JSON file
   std::uint32_t seed = 1;            ///< seed of the random searches
   std::string drrMethod = "siddon";  ///< DRR method (DrrRendererFactory names)
 

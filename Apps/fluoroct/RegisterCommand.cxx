@@ -41,7 +41,7 @@ struct Options {
   std::string views;
   std::string init;
   std::string landmarks;
-  std::string preset = "paper";
+  std::string preset = RegistrationSchedule::kDefaultPreset;
   std::uint32_t seed = 1;
   std::string method = "siddon";
   std::string transgraphCache;  ///< empty = the default cache folder; "none" = no cache
@@ -501,7 +501,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       "Landmark pair file {\"ct\": \"points.mrk.json\", \"image\": \"clicks.json\", \"method\": "
       "\"reprojection\"|\"triangulation\"} (paths relative to it)");
   init->excludes(landmarks);
-  command->add_option("--preset", options->preset, "Schedule: 'paper', 'fast' or a preset JSON file")
+  command->add_option("--preset", options->preset, "Schedule: 'clinical', 'paper' (the paper's), 'fast' or a preset JSON file")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the random searches")->capture_default_str();
   command->add_option("--method", options->method,

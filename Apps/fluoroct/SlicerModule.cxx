@@ -100,8 +100,8 @@ std::string registerModuleXml() {
       <name>preset</name>
       <longflag>preset</longflag>
       <label>Preset</label>
-      <description><![CDATA[Registration schedule: 'paper' (the published three stages) or 'fast'.]]></description>
-      <default>paper</default>
+      <description><![CDATA[Registration schedule: 'clinical' (the paper's accuracy, fast), 'paper' (the published three stages) or 'fast'.]]></description>
+      <default>clinical</default>
 {}    </string-enumeration>
     <integer>
       <name>seed</name>

@@ -133,12 +133,12 @@ Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expecte
   return status;
 }
 
-Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level,
-                                              const Eigen::Isometry3d& T_world_from_ct) const {
+Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct,
+                                              int pixelStride) const {
   const Camera levelCamera = m_views[v].camera.downsampled(level);
   const CameraIntrinsics& in = levelCamera.intrinsics();
   const double depth_mm = (levelCamera.T_camera_from_world() * T_world_from_ct * m_centre_ct_mm).z();
-  const double footprint_mm = in.pixelSpacing_mm.minCoeff() * depth_mm / in.sourceToDetector_mm;
+  const double footprint_mm = pixelStride * in.pixelSpacing_mm.minCoeff() * depth_mm / in.sourceToDetector_mm;
   const Eigen::Vector3d& spacing_mm = m_drrVolume->values().spacing_mm();
   Eigen::Vector3i block;
   for (int a = 0; a < 3; ++a) block[a] = std::max(1, static_cast<int>(std::floor(footprint_mm / spacing_mm[a])));
@@ -146,9 +146,9 @@ Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level,
 }
 
 Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int level,
-                                                           const Eigen::Isometry3d& T_world_from_ct) {
+                                                           const Eigen::Isometry3d& T_world_from_ct, int pixelStride) {
   if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
-  const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct);
+  const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct, std::max(1, pixelStride));
   if ((block.array() == 1).all()) return m_renderer.get();
   const std::array<int, 3> key{block.x(), block.y(), block.z()};
   auto found = m_coarseRenderers.find(key);

@@ -69,13 +69,17 @@ class RegistrationCase {
   const DrrRenderer& renderer() const { return *m_renderer; }
   /// The exact renderer for view v at pyramid `level` with the CT near pose T_world_from_ct: renderer()'s method over
   /// the CT box-averaged to the level's pixel footprint (ctBlockSize()), so coarse levels traverse fewer, larger voxels
-  /// and their DRRs carry the blur of their pixels; renderer() itself where the block is one voxel. Coarse CTs are
-  /// made on first use and kept. Fails on a bad view or level.
-  Result<const DrrRenderer*> levelRenderer(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct);
+  /// and their DRRs carry the blur of their pixels; renderer() itself where the block is one voxel. `pixelStride` > 1:
+  /// the rendered pixels are every pixelStride-th column and row of the level, so the footprint is that many pixels.
+  /// Coarse CTs are made on first use and kept. Fails on a bad view or level.
+  Result<const DrrRenderer*> levelRenderer(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct,
+                                           int pixelStride = 1);
   /// The CT voxels per axis that levelRenderer() averages for view v at `level`: floor(pixel footprint / voxel
   /// spacing), at least 1, where the footprint is the level's smaller pixel side scaled to the depth of the rotation
-  /// centre at T_world_from_ct (the pixel's size at the bone). v and level must be valid (levelRenderer checks them).
-  Eigen::Vector3i ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const;
+  /// centre at T_world_from_ct (the pixel's size at the bone), times `pixelStride`. v and level must be valid
+  /// (levelRenderer checks them).
+  Eigen::Vector3i ctBlockSize(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct,
+                              int pixelStride = 1) const;
   /// The renderer of view v: its Transgraph once built (transgraph method), else renderer().
   const DrrRenderer& renderer(std::size_t v) const { return *m_views[v].renderer; }
   /// The Transgraph renderer of view v, or null (other method, or tables not built yet).

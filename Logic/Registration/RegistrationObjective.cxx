@@ -14,11 +14,16 @@ namespace fct {
 
 namespace {
 
-/// The pixels of `pixels` (linear indices of a level `cols` wide) on every k-th column and row, k the smallest stride
-/// that keeps at most maxPixels of them (approximately: the valid pixels are assumed evenly spread).
-PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int maxPixels) {
-  if (pixels.size() <= static_cast<std::size_t>(maxPixels)) return pixels;
-  const int k = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(pixels.size()) / maxPixels)));
+/// The smallest stride k such that every k-th column and row of `count` pixels keeps at most maxPixels of them
+/// (approximately: the valid pixels are assumed evenly spread); 1 when maxPixels is 0 (no cap) or not exceeded.
+int strideFor(std::size_t count, int maxPixels) {
+  if (maxPixels <= 0 || count <= static_cast<std::size_t>(maxPixels)) return 1;
+  return static_cast<int>(std::ceil(std::sqrt(static_cast<double>(count) / maxPixels)));
+}
+
+/// The pixels of `pixels` (linear indices of a level `cols` wide) on every k-th column and row.
+PixelIndexList everyKth(const PixelIndexList& pixels, int cols, int k) {
+  if (k <= 1) return pixels;
   PixelIndexList kept;
   kept.reserve(pixels.size() / (static_cast<std::size_t>(k) * k) + 1);
   for (const std::int32_t index : pixels) {
@@ -104,11 +109,6 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
     View view;
     view.renderer = useViewRenderers ? &registrationCase.renderer(v) : &registrationCase.renderer();
     const bool tableRenderer = useViewRenderers && registrationCase.transgraph(v) != nullptr;
-    if (!tableRenderer && T_coarseCt_world_from_ct) {
-      auto levelRenderer = registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct);
-      if (!levelRenderer) return fail(fmt::format("{}: {}", where(v), levelRenderer.error()));
-      view.renderer = levelRenderer.value();
-    }
     view.camera = registrationCase.camera(v);
     std::optional<ValidMask> cutFaces;
     if (T_cutFaces_world_from_ct) {
@@ -123,6 +123,7 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
     // The pixel set: windows for VLNC and for ROIs, the valid pixels otherwise.
     const bool windows = stage.metric == SimilarityMetric::Vlnc || stage.pixels.kind == PixelSetKind::Rois;
     RoiSelection selection;
+    int stride = 1;  // a capped whole-image set keeps every stride-th column and row
     if (windows) {
       const bool rois = stage.pixels.kind == PixelSetKind::Rois;
       // With cut faces, the ROIs are the strongest of the windows clear of them.
@@ -154,12 +155,21 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
           validCount = pyramidLevel.mask.validCount();
         }
       }
-      if (stage.pixels.maxPixels > 0) view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stage.pixels.maxPixels);
+      stride = strideFor(view.pixels.size(), stage.pixels.maxPixels);
+      view.pixels = everyKth(view.pixels, pyramidLevel.image.cols, stride);
     }
     if (view.pixels.empty()) {
       return fail(fmt::format("{}: the pixel set is empty (no valid pixel at level {}, or every ray crosses the CT's "
                               "cut faces); reduce the masks, the cut-face margin, or use a finer level",
                               where(v), level));
+    }
+    // Each kept pixel of a capped NCC set stands for stride x stride pixels: the CT is coarsened to that footprint
+    // (fewer, larger voxels per ray), as the level's own pixels are. (GC renders the whole level: no coarsening.)
+    if (!tableRenderer && T_coarseCt_world_from_ct) {
+      const int footprintStride = stage.metric == SimilarityMetric::Ncc ? stride : 1;
+      auto levelRenderer = registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct, footprintStride);
+      if (!levelRenderer) return fail(fmt::format("{}: {}", where(v), levelRenderer.error()));
+      view.renderer = levelRenderer.value();
     }
     view.keptFraction = validCount ? static_cast<double>(view.pixels.size()) / static_cast<double>(validCount) : 0.0;
 

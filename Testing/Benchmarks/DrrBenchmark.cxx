@@ -29,6 +29,7 @@
 #include "Geometry/Camera.h"
 #include "Geometry/RigidPose.h"
 #include "IO/Dicom/DicomSeriesReader.h"
+#include "IO/Project/ViewFile.h"
 #include "IO/Volume/VolumeFileIO.h"
 
 namespace {
@@ -48,6 +49,8 @@ struct Options {
   double offsetFactor = 3.0;  // Transgraph offset step / plane step (the library's default)
   int nccPoses = 20;
   bool plastimatch = true;
+  int wholeProcessViews = 0;  // > 0: only the whole-process comparison, `fluoroct drr` vs `plastimatch drr`
+  fs::path fluoroct;          // the fluoroct program of the whole-process comparison
 };
 
 struct Row {
@@ -373,6 +376,102 @@ void benchmarkCt(const std::string& name, const fct::Volume& ctIn, const Options
   }
 }
 
+// Wall time of a shell command (its output goes to `log`); NAN when it fails.
+double timedCommand(const std::string& command, const fs::path& log) {
+  const auto start = Clock::now();
+  const int status = std::system(fmt::format("{} > \"{}\" 2>&1", command, log.string()).c_str());
+  return status == 0 ? seconds(start) : NAN;
+}
+
+// Whole process, the way a user runs each program: `fluoroct drr` reads the DICOM series and renders `viewCount`
+// views of 800 x 600 in one call; `plastimatch drr -A cpu -i exact` reads the CT (a MetaImage of max(HU + 1000, 0)
+// with an identity direction, `-P none`, so both integrate proportional values) and renders the same views as one
+// gantry rotation (`-a N -N 360/N`: image k has its source at isocentre + SAD (cos a, -sin a, 0), a = k 360/N, vup +z). Median wall time of
+// `repeats` runs each, alternating; NCC per view between the two programs' output files.
+void wholeProcess(const fs::path& dicomFolder, const Options& options, std::vector<std::string>& ratios) {
+  auto read = fct::DicomSeriesReader::read(dicomFolder);
+  if (!read) {
+    fmt::print("whole-process comparison skipped: {}\n", read.error());
+    return;
+  }
+  auto identity = withIdentityDirection(read.value());
+  if (!identity) {
+    fmt::print("whole-process comparison skipped: {}\n", identity.error());
+    return;
+  }
+  fct::Volume shifted = identity.value();
+  for (float& v : shifted.voxels()) v = std::max(v + 1000.0f, 0.0f);
+  fs::create_directories(options.workDir);
+  const fs::path mha = options.workDir / "head_shifted.mha";
+  if (auto written = fct::VolumeFileIO::write(shifted, mha); !written) {
+    fmt::print("whole-process comparison skipped: {}\n", written.error());
+    return;
+  }
+  const Eigen::Vector3d isocentre = identity.value().centre_lps_mm();
+  const int n = options.wholeProcessViews;
+  const double step_deg = 360.0 / n;
+  std::vector<fct::ViewSpec> views;
+  for (int k = 0; k < n; ++k) {
+    const double a = k * step_deg * M_PI / 180.0;
+    const Eigen::Vector3d nrm(std::cos(a), -std::sin(a), 0.0), vup = Eigen::Vector3d::UnitZ();
+    Eigen::Matrix3d R;  // camera z from the source to the detector, x along the columns, y down the rows
+    R.col(2) = -nrm;
+    R.col(0) = vup.cross(nrm).normalized();
+    R.col(1) = R.col(2).cross(R.col(0));
+    fct::ViewSpec view;
+    view.name = fmt::format("g{:03.0f}", k * step_deg);
+    view.camera = fct::Camera::lookingAt(isocentre, R, kSad_mm, kSid_mm, kCols, kRows, kPixel_mm);
+    views.push_back(view);
+  }
+  const fs::path viewFile = options.workDir / "views8.json";
+  if (auto written = fct::ViewFile::write(views, viewFile); !written) {
+    fmt::print("whole-process comparison skipped: {}\n", written.error());
+    return;
+  }
+  const std::string ours = fmt::format("\"{}\" drr --ct \"{}\" --views \"{}\" --out \"{}\"", options.fluoroct.string(),
+                                       dicomFolder.string(), viewFile.string(), (options.workDir / "ours.pfm").string());
+  const std::string theirs = fmt::format(
+      "OMP_NUM_THREADS={} plastimatch drr -A cpu -i exact -P none -t pfm --sad {} --sid {} -r \"{} {}\" -z \"{} {}\" "
+      "-o \"{} {} {}\" -a {} -N {} --vup \"0 0 1\" -O \"{}\" \"{}\"",
+      options.threads, kSad_mm, kSid_mm, kCols, kRows, kCols * kPixel_mm, kRows * kPixel_mm, isocentre.x(),
+      isocentre.y(), isocentre.z(), n, step_deg, (options.workDir / "theirs_").string(), mha.string());
+  std::vector<double> oursTimes, theirsTimes;
+  for (int i = 0; i < options.repeats; ++i) {
+    oursTimes.push_back(timedCommand(ours, options.workDir / "ours.log"));
+    theirsTimes.push_back(timedCommand(theirs, options.workDir / "theirs.log"));
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  const double ours_s = median(oursTimes), theirs_s = median(theirsTimes);
+  double nccMin = 1.0;
+  for (int k = 0; k < n; ++k) {
+    auto a = readPfm(options.workDir / fmt::format("ours_{}.pfm", views[static_cast<std::size_t>(k)].name), kCols, kRows);
+    auto b = readPfm(options.workDir / fmt::format("theirs_{:04d}.pfm", k), kCols, kRows);
+    if (!a || !b) {
+      fmt::print("whole-process comparison: {}\n", !a ? a.error() : b.error());
+      nccMin = NAN;
+      break;
+    }
+    // Our PFM is stored bottom row first (the PFM convention), plastimatch's top row first.
+    std::vector<float> flipped(a.value().size());
+    for (int r = 0; r < kRows; ++r) {
+      std::copy_n(a.value().begin() + static_cast<std::ptrdiff_t>(r) * kCols, kCols,
+                  flipped.begin() + static_cast<std::ptrdiff_t>(kRows - 1 - r) * kCols);
+    }
+    nccMin = std::min(nccMin, ncc(flipped, b.value()));
+  }
+  fmt::print("== whole process, head, {} views of {}x{}: fluoroct drr {:.3f} s, plastimatch drr -i exact {:.3f} s "
+             "(median of {}), NCC min over views {:.5f}\n",
+             n, kCols, kRows, ours_s, theirs_s, options.repeats, nccMin);
+  ratios.push_back(fmt::format("whole_process fluoroct_drr_s head: {:.3f}", ours_s));
+  ratios.push_back(fmt::format("whole_process plastimatch_exact_s head: {:.3f}", theirs_s));
+  ratios.push_back(fmt::format("ratio whole_process plastimatch_exact/fluoroct_drr head: {:.2f}", theirs_s / ours_s));
+  ratios.push_back(fmt::format("ncc whole_process fluoroct/plastimatch min head: {:.5f}", nccMin));
+  fs::remove(mha);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -392,6 +491,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.25, 8.0));
   app.add_option("--ncc-poses", options.nccPoses, "random poses for the Transgraph NCC")->check(CLI::Range(1, 1000));
   app.add_option("--work", options.workDir, "scratch folder for plastimatch's input and output");
+  app.add_option("--whole-process", options.wholeProcessViews,
+                 "only the whole-process comparison on the head: fluoroct drr vs plastimatch drr, N views")
+      ->check(CLI::Range(1, 360));
   bool noPlastimatch = false;
   app.add_flag("--no-plastimatch", noPlastimatch, "skip the plastimatch comparison");
   CLI11_PARSE(app, argc, argv);
@@ -400,6 +502,12 @@ int main(int argc, char** argv) {
 
   std::vector<Row> rows;
   std::vector<std::string> ratios;
+  if (options.wholeProcessViews > 0) {
+    options.fluoroct = fs::path(argv[0]).parent_path() / "fluoroct";
+    if (options.plastimatch) wholeProcess(options.dataDir / "ct/head_phantom_philips_bone", options, ratios);
+    for (const auto& line : ratios) fmt::print("{}\n", line);
+    return 0;
+  }
   const fs::path pelvisPath = options.dataDir / "ct/pelvis_totalseg.nii.gz";
   if (auto pelvis = fct::VolumeFileIO::read(pelvisPath); pelvis) {
     benchmarkCt("pelvis", pelvis.value(), options, rows, ratios);

@@ -18,6 +18,7 @@
 #include "Base/TextFile.h"
 #include "IO/Project/ItkTransformFile.h"
 #include "IO/Project/PoseFile.h"
+#include "Registration/RegistrationSchedule.h"
 #include "SimulatedCliCase.h"
 
 namespace {
@@ -255,8 +256,8 @@ TEST(SlicerModule, RegisterDescriptionFollowsTheExecutionModel) {
   EXPECT_EQ(parameterNamed(check, "landmarks").tag, "file");
   const Parameter preset = parameterNamed(check, "preset");
   EXPECT_EQ(preset.tag, "string-enumeration");
-  EXPECT_EQ(preset.fields.count("element"), 2u);
-  EXPECT_EQ(preset.field("default"), "paper");
+  EXPECT_EQ(preset.fields.count("element"), fct::RegistrationSchedule::builtinNames().size());
+  EXPECT_EQ(preset.field("default"), fct::RegistrationSchedule::kDefaultPreset);
   for (const char* output : {"finalSimilarity", "registrationSeconds", "drrCount"}) {
     EXPECT_EQ(parameterNamed(check, output).field("channel"), "output") << output;
   }

@@ -27,7 +27,25 @@ TEST(RegistrationSchedule, PaperPresetHasThePapersThreeStages) {
   EXPECT_EQ(s[2].level, 0);
   EXPECT_EQ(s[2].pixels.kind, fct::PixelSetKind::Rois);
   EXPECT_EQ(s[2].search, fct::SearchStrategy::Local);
-  EXPECT_EQ(RegistrationSchedule::builtinNames(), (std::vector<std::string>{"fast", "paper"}));
+  EXPECT_EQ(RegistrationSchedule::builtinNames(), (std::vector<std::string>{"clinical", "fast", "paper"}));
+}
+
+TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) {
+  auto preset = RegistrationSchedule::builtin(RegistrationSchedule::kDefaultPreset);
+  ASSERT_TRUE(preset.ok()) << preset.error();
+  const auto& s = preset.value().stages;
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_EQ(s[0].metric, fct::SimilarityMetric::Ncc);
+  EXPECT_EQ(s[0].search, fct::SearchStrategy::Genetic);
+  EXPECT_GT(s[0].pixels.maxPixels, 0) << "the global stage samples its level sparsely";
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    EXPECT_EQ(s[i].metric, fct::SimilarityMetric::Vlnc);
+    EXPECT_EQ(s[i].pixels.kind, fct::PixelSetKind::Rois);
+  }
+  EXPECT_EQ(s.back().level, 0) << "ends at full resolution";
+  int budget = 0;
+  for (const auto& stage : s) budget += stage.maxEvaluations;
+  EXPECT_LE(3 * budget, 4500) << "about the paper's 3,000 DRRs for 3 views, not 8,500";
 }
 
 TEST(RegistrationSchedule, JsonRoundTripGivesTheSameSchedule) {

@@ -45,9 +45,9 @@ fct::test::KnownTruthOptions coarseDetector() {
   return options;
 }
 
-fct::RegistrationOptions fastOptions(std::uint32_t seed = 1) {
+fct::RegistrationOptions fastOptions(std::uint32_t seed = 1, const std::string& preset = "fast") {
   fct::RegistrationOptions options;
-  options.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  options.schedule = fct::RegistrationSchedule::builtin(preset).value();
   options.seed = seed;
   return options;
 }
@@ -56,13 +56,13 @@ double errorOf(const Prepared& p, const Eigen::Isometry3d& T) {
   return p.registrationCase.bone()->meanDistance_mm(T, p.simulated.T_truth);
 }
 
-/// Runs `starts` registrations from 10 mm and returns how many end within 0.5 mm; prints every error.
-int successes(Prepared& p, int starts, std::uint32_t firstSeed) {
+/// Runs `starts` registrations from 10 mm with `preset` and returns how many end within 0.5 mm; prints every error.
+int successes(Prepared& p, int starts, std::uint32_t firstSeed, const std::string& preset = "fast") {
   int within = 0;
   for (int s = 0; s < starts; ++s) {
     const Eigen::Isometry3d start = fct::test::startPose(p.registrationCase, p.simulated.T_truth, 10.0, firstSeed + s);
     EXPECT_NEAR(errorOf(p, start), 10.0, 0.01);
-    auto result = fct::Registration::run(p.registrationCase, start, fastOptions(firstSeed + s));
+    auto result = fct::Registration::run(p.registrationCase, start, fastOptions(firstSeed + s, preset));
     EXPECT_TRUE(result.ok()) << result.error();
     if (!result) continue;
     const double error = errorOf(p, result.value().T_world_from_ct);
@@ -78,6 +78,11 @@ int successes(Prepared& p, int starts, std::uint32_t firstSeed) {
 TEST(Registration, FastPresetRecoversPhantomPoseFrom10mmIn19Of20Starts) {
   Prepared p = preparePhantom();
   EXPECT_GE(successes(p, 20, 1000), 19);
+}
+
+TEST(Registration, DefaultPresetRecoversPhantomPoseFrom10mmIn19Of20Starts) {
+  Prepared p = preparePhantom();
+  EXPECT_GE(successes(p, 20, 1000, fct::RegistrationSchedule::kDefaultPreset), 19);
 }
 
 TEST(Registration, FastPresetRecoversPelvisPoseFrom10mm) {
@@ -344,6 +349,9 @@ TEST(Registration, CtPyramidCoarsensTheCtOnlyWherePixelsSpanSeveralVoxels) {
   EXPECT_EQ(coarse->volume().values().spacing_mm(), Eigen::Vector3d(4.0, 4.0, 4.0));
   EXPECT_EQ(rc.levelRenderer(1, 2, T).value(), coarse) << "views share a coarse CT of the same block";
   EXPECT_FALSE(rc.levelRenderer(0, rc.levelCount(), T).ok());
+  // Every second column and row of level 2: each pixel stands for 8.96 mm at the bone, four 2 mm voxels.
+  EXPECT_EQ(rc.ctBlockSize(0, 2, T, 2), Eigen::Vector3i(4, 4, 4));
+  EXPECT_EQ(rc.levelRenderer(0, 2, T, 2).value()->volume().values().spacing_mm(), Eigen::Vector3d(8.0, 8.0, 8.0));
 
   // The coarse DRR is the full CT's DRR blurred by about one pixel: nearly the same image.
   const fct::FloatImage full = rc.renderer().render(rc.camera(0), T, 2).value();
