@@ -27,10 +27,11 @@ std::vector<FuzzTarget> allTargets() {
   return targets;
 }
 
-/// The seeds the project's writers make, written once per test program.
+/// The seeds the project's writers make, written once per test program into the first test's own folder (CTest runs
+/// the targets as parallel processes, which must not share a folder).
 const fs::path& writtenSeeds() {
   static const fs::path root = [] {
-    const fs::path folder = fct::test::scratchDir().parent_path() / "fuzz_seeds";
+    const fs::path folder = fct::test::scratchDir() / "fuzz_seeds";
     std::error_code ec;
     fs::remove_all(folder, ec);
     const fct::Status loaders = fct::fuzz::writeLoaderSeeds(folder);
