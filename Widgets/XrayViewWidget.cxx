@@ -8,6 +8,14 @@ namespace fct {
 
 namespace {
 
+/// `high`, lowered to the values' median + kTailIqrs interquartile ranges where a long bright tail (the thin edge of a
+/// thick patient, e.g. a lateral pelvis) would otherwise leave most of the pixels in the window's darkest few levels.
+double belowTheBrightTail(const std::vector<float>& values, double high) {
+  const double median = ImageViewWidget::quantile(values, 0.5);
+  const double iqr = ImageViewWidget::quantile(values, 0.75) - ImageViewWidget::quantile(values, 0.25);
+  return std::min(high, median + XrayViewWidget::kTailIqrs * iqr);
+}
+
 /// The low and high window ends of a preset over the field-of-view pixels `field` (MONOCHROME2 values).
 std::pair<double, double> presetRange(XrayWindowPreset preset, const std::vector<float>& field) {
   if (preset == XrayWindowPreset::FullRange) {
@@ -25,9 +33,12 @@ std::pair<double, double> presetRange(XrayWindowPreset preset, const std::vector
     if (value < directLevel) patient.push_back(value);
   }
   const double directFraction = 1.0 - static_cast<double>(patient.size()) / static_cast<double>(field.size());
-  if (directFraction < XrayViewWidget::kMinDirectExposureFraction || patient.size() < 100) return {low, high};
+  if (directFraction < XrayViewWidget::kMinDirectExposureFraction || patient.size() < 100) {
+    return {low, belowTheBrightTail(field, high)};
+  }
   // The upper part of the patient's pixels is the thin skin edge ramping up to the direct exposure: leave it out.
-  return {ImageViewWidget::quantile(patient, 0.01), ImageViewWidget::quantile(patient, XrayViewWidget::kPatientHighQuantile)};
+  return {ImageViewWidget::quantile(patient, 0.01),
+          belowTheBrightTail(patient, ImageViewWidget::quantile(patient, XrayViewWidget::kPatientHighQuantile))};
 }
 
 }  // namespace

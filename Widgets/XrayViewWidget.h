@@ -5,7 +5,8 @@
 // least kMinDirectExposureFraction of them is direct exposure (the unattenuated beam, within 5 % of the range below
 // the 99th percentile, which would take most grey levels and leave the bone nearly black), the 1st to
 // kPatientHighQuantile percentile of the darker, patient pixels (their upper part is the skin edge ramping up to the
-// direct exposure). Presets give the whole field (1st-99th percentile of every field-of-view pixel) and the full
+// direct exposure). Either high end is lowered to the median + kTailIqrs interquartile ranges of those pixels when a
+// long bright tail (the thin edges of a thick patient) lies above it. Presets give the whole field (1st-99th percentile of every field-of-view pixel) and the full
 // range (minimum to maximum).
 
 #include <QString>
@@ -30,6 +31,8 @@ class XrayViewWidget : public ImageViewWidget {
   static constexpr double kMinDirectExposureFraction = 0.1;
   /// Upper quantile of the patient pixels the automatic window ends at when there is a direct exposure.
   static constexpr double kPatientHighQuantile = 0.8;
+  /// The automatic window's high end is at most this many interquartile ranges above the median.
+  static constexpr double kTailIqrs = 3.0;
 
   /// An empty X-ray view.
   explicit XrayViewWidget(QWidget* parent = nullptr);

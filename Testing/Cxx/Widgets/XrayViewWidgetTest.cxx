@@ -206,4 +206,28 @@ TEST(XrayViewWidget, AnImageWithoutDirectExposureOpensAtItsRobustRange) {
   EXPECT_FALSE(view.hasImage());
 }
 
+TEST(XrayViewWidget, AThickPatientWithBrightThinEdgesOpensWithItsBodyInTheMidGreys) {
+  // A lateral pelvis: 90 % of the field is the body at 30-190 counts, the rest a thin edge ramping up to 12000 counts,
+  // too little of it at the top for a direct exposure; the 1st-99th percentile window left the body in its darkest 6 %.
+  XrayViewWidget view;
+  fct::XrayImage xray;
+  xray.cols = 100;
+  xray.rows = 100;
+  for (int i = 0; i < 10000; ++i) {
+    const bool edge = i % 100 >= 90;
+    xray.pixels.push_back(edge ? 200.0f + 12000.0f * static_cast<float>((i / 100) % 100) / 99.0f
+                               : 30.0f + static_cast<float>((i * 7) % 160));
+  }
+  view.setImage(xray);
+  const double low = view.level() - 0.5 * view.window();
+  const double high = view.level() + 0.5 * view.window();
+  const double bodyMedian = 110.0;
+  const double shownAt = (bodyMedian - low) / (high - low);
+  EXPECT_GT(shownAt, 0.15) << "W " << view.window() << " L " << view.level();
+  EXPECT_LT(shownAt, 0.85) << "W " << view.window() << " L " << view.level();
+  EXPECT_GE(high, 190.0) << "the whole body stays inside the window";
+  view.applyWindowPreset(fct::XrayWindowPreset::WholeField);
+  EXPECT_GT(view.level() + 0.5 * view.window(), 10000.0) << "the whole-field preset still reaches the bright edge";
+}
+
 }  // namespace
