@@ -3,6 +3,8 @@
 #include <fmt/core.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -130,6 +132,41 @@ Status writeBinarySeeds(const fs::path& root) {
   return DewarpFile::write(contents, root / "dewarp" / "field.dewarp.json");
 }
 
+/// A 6x5x4 int16 NIfTI-1 single file (1 mm voxels, no orientation codes) whose data starts at `voxOffset`.
+std::string niftiBytes(float voxOffset) {
+  std::string bytes(352 + 6 * 5 * 4 * sizeof(std::int16_t), '\0');
+  const auto put = [&bytes](std::size_t at, const void* value, std::size_t size) { std::memcpy(&bytes[at], value, size); };
+  const std::int32_t headerSize = 348;
+  const std::int16_t dim[8] = {3, 6, 5, 4, 1, 1, 1, 1}, datatypeInt16 = 4, bitsPerVoxel = 16;
+  const float pixdim[8] = {1, 1, 1, 1, 0, 0, 0, 0}, slope = 1.0f;
+  put(0, &headerSize, sizeof headerSize);
+  put(40, dim, sizeof dim);
+  put(70, &datatypeInt16, sizeof datatypeInt16);
+  put(72, &bitsPerVoxel, sizeof bitsPerVoxel);
+  put(76, pixdim, sizeof pixdim);
+  put(108, &voxOffset, sizeof voxOffset);
+  put(112, &slope, sizeof slope);
+  put(344, "n+1", 4);
+  return bytes;
+}
+
+/// Small inputs written from their description: a NIfTI seed, and the inputs of the loader defects fuzzing found
+/// (a NIfTI vox_offset beyond the file, NRRD and MetaImage sizes beyond int).
+Status writeCraftedSeeds(const fs::path& root) {
+  const std::string data(64, '\x11');
+  for (const auto& [file, bytes] : std::vector<std::pair<std::string, std::string>>{
+           {"nifti/int16_6x5x4.nii", niftiBytes(352.0f)},
+           {"nifti/vox_offset_beyond_the_file.nii", niftiBytes(5.4e8f)},
+           {"nrrd/sizes_beyond_int.nrrd", "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
+                                          "sizes: 10 8 777777777777777777777777777778\nencoding: raw\n\n" + data},
+           {"mha/dimsize_beyond_int.mha", "ObjectType = Image\nNDims = 3\nBinaryData = True\nElementSpacing = 1 1 2\n"
+                                          "DimSize = 11111111111111111111111111110 6 8\nElementType = MET_SHORT\n"
+                                          "ElementDataFile = LOCAL\n" + data}}) {
+    if (Status written = writeBytes(root / file, bytes); !written) return written;
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Status writeLoaderSeeds(const fs::path& root) {
@@ -138,7 +175,7 @@ Status writeLoaderSeeds(const fs::path& root) {
     fs::create_directories(root / target.name, ec);
     if (ec) return fail(fmt::format("cannot create the seed folder {}: {}", (root / target.name).string(), ec.message()));
   }
-  for (Status (*write)(const fs::path&) : {writeVolumeSeeds, writeImageSeeds, writeProjectSeeds, writeBinarySeeds}) {
+  for (Status (*write)(const fs::path&) : {writeVolumeSeeds, writeImageSeeds, writeProjectSeeds, writeBinarySeeds, writeCraftedSeeds}) {
     if (Status written = write(root); !written) return written;
   }
   return Ok{};
