@@ -4,6 +4,7 @@
 #include <dcmtk/dcmdata/dcfilefo.h>
 #include <dcmtk/dcmdata/dcxfer.h>
 #include <fmt/core.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -141,10 +142,18 @@ Result<FolderContents> scanFolder(const fs::path& folder) {
 
   FolderContents contents;
   contents.filesLookedAt = static_cast<int>(paths.size());
-  for (const fs::path& path : paths) {
-    const Signature signature = fileSignature(path);
+  // Headers are parsed in parallel (file reads and DCMTK parsing dominate), then taken in path order so the result
+  // and the first error do not depend on the thread count.
+  std::vector<Signature> signatures(paths.size(), Signature::None);
+  std::vector<Result<SliceHeader>> headers(paths.size(), fail("not read"));
+  tbb::parallel_for(std::size_t{0}, paths.size(), [&](std::size_t n) {
+    signatures[n] = fileSignature(paths[n]);
+    if (signatures[n] != Signature::None) headers[n] = readHeader(paths[n]);
+  });
+  for (std::size_t n = 0; n < paths.size(); ++n) {
+    const Signature signature = signatures[n];
     if (signature == Signature::None) continue;
-    auto header = readHeader(path);
+    Result<SliceHeader>& header = headers[n];
     if (!header) {
       if (signature == Signature::RawDataset) continue;  // a guess that did not parse: not DICOM after all
       return fail(header.error());
@@ -386,8 +395,13 @@ Result<Volume> DicomSeriesReader::read(const fs::path& folder, const DicomSeries
                             "(the default policy, at the smallest slice gap or a spacing of your choice) or export it "
                             "from the scanner without tilt and gaps", uid, irregularity));
   }
-  for (int k = 0; k < stack.sliceCount(); ++k) {
-    if (Status decoded = decodeSlice(headers[k], stack.slice(k)); !decoded) return fail(decoded.error());
+  // Slices decode in parallel into their own planes; the first failing slice (in order) is reported.
+  std::vector<Status> decoded(static_cast<std::size_t>(stack.sliceCount()), Ok{});
+  tbb::parallel_for(0, stack.sliceCount(), [&](int k) {
+    decoded[static_cast<std::size_t>(k)] = decodeSlice(headers[static_cast<std::size_t>(k)], stack.slice(k));
+  });
+  for (const Status& status : decoded) {
+    if (!status) return fail(status.error());
   }
 
   const SliceHeader& first = headers.front();
