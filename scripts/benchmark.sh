@@ -114,11 +114,14 @@ if ((SCALING)); then
     make_case "head-v$count" "$head_ct" 512 512 0.45 "$count"
     run_config "head-v$count" "$head_ct" default 1
   done
-  # The head CT at full and at half resolution (every second voxel along each axis, plastimatch resample).
+  # The head CT at full and at half resolution (every second voxel along each axis), and resampled to 512x512x400
+  # (0.35 mm slices, the memory case: it must register in <= 2 GB), with plastimatch resample.
   if command -v plastimatch > /dev/null; then
     plastimatch convert --input "$head_ct" --output-img "$WORK/head_full.mha" > /dev/null 2>&1
     plastimatch resample --input "$WORK/head_full.mha" --output "$WORK/head_half.mha" --subsample "2 2 2" > /dev/null 2>&1
-    for res in full half; do
+    plastimatch resample --input "$WORK/head_full.mha" --output "$WORK/head_400.mha" --dim "512 512 400" \
+      --spacing "$(plastimatch header "$WORK/head_full.mha" | awk '/^Spacing/ {print $3, $4}') 0.35" > /dev/null 2>&1
+    for res in full half 400; do
       make_case "head-$res" "$WORK/head_$res.mha" 512 512 0.45 3
       run_config "head-$res" "$WORK/head_$res.mha" default 1
     done
