@@ -44,8 +44,9 @@ void addTable2(StudyDefinition& d, const std::vector<std::string>& cts) {
 }
 
 void addCapture(StudyDefinition& d, const std::vector<std::string>& cts) {
-  d.title = "Capture range by similarity measure (the paper's Fig. 3): initial mean sTRE bins, 3 views";
-  const int bins = d.quick ? 2 : 6;
+  d.title = "Capture range by similarity measure (the paper's Fig. 3): initial mean sTRE bins, 3 views; with both "
+            "measures also start rotations and the clinical setup alone (supine at the isocentre, no landmarks)";
+  const int bins = d.quick ? 2 : 10;
   struct Measure {
     const char* name;
     StudyMeasures measures;
@@ -63,6 +64,21 @@ void addCapture(StudyDefinition& d, const std::vector<std::string>& cts) {
         d.conditions.push_back(std::move(c));
       }
     }
+    // Rotational capture: the truth rotated by 0-10, 10-20 and 20-30 deg about a random axis through the bone centre.
+    for (int b = 0; b < (d.quick ? 1 : 3); ++b) {
+      StudyCondition c = baseCondition(ct, kRealistic, d.quick ? 2 : 10);
+      c.variant = "both";
+      c.start = StudyStart::Rotation;
+      c.rotationLow_deg = 10.0 * b;
+      c.rotationHigh_deg = 10.0 * (b + 1);
+      c.name = fmt::format("{}/both/rotation-{:02d}-{:02d}deg", ct, 10 * b, 10 * (b + 1));
+      d.conditions.push_back(std::move(c));
+    }
+    StudyCondition setup = baseCondition(ct, kRealistic, d.quick ? 2 : 10);
+    setup.variant = "both";
+    setup.start = StudyStart::SupineSetup;
+    setup.name = fmt::format("{}/both/supine-setup", ct);
+    d.conditions.push_back(std::move(setup));
   }
 }
 

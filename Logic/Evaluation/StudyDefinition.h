@@ -21,6 +21,14 @@ enum class StudyMeasures {
   VlncOnly,  ///< VLNC in every stage (the first stage's whole images become every complete window)
 };
 
+/// How a trial's start pose is made.
+enum class StudyStart {
+  SurfaceDistance,  ///< a random pose at a mean bone-surface distance in [initialLow_mm, initialHigh_mm] from the truth
+  Rotation,         ///< the truth rotated about the bone centre by an angle in [rotationLow_deg, rotationHigh_deg]
+                    ///< about a random axis (no translation)
+  SupineSetup,      ///< the clinical setup alone, no landmarks: supine at the C-arm isocentre (SetupPose)
+};
+
 /// One compared condition of a study; its trials differ only by the random start pose and search seed.
 struct StudyCondition {
   std::string name;               ///< unique within the study, e.g. "pelvis/realistic" (the resume key with the trial)
@@ -36,6 +44,9 @@ struct StudyCondition {
   StudyMeasures measures = StudyMeasures::Both;
   double initialLow_mm = 10.0;    ///< initial mean sTRE drawn uniformly in [low, high] per trial (equal: fixed)
   double initialHigh_mm = 10.0;
+  StudyStart start = StudyStart::SurfaceDistance;
+  double rotationLow_deg = 0.0;   ///< StudyStart::Rotation: angle drawn uniformly in [low, high] per trial
+  double rotationHigh_deg = 0.0;
   int trials = 10;
 };
 

@@ -37,9 +37,11 @@ std::vector<TrialRecord> recordsOf(const StudyDefinition& study, const StudyCond
 
 /// Conditions grouped by (CT, variant), in definition order: the series of capture and views charts.
 std::vector<std::pair<std::string, std::vector<const StudyCondition*>>> groups(const StudyDefinition& study,
-                                                                              bool byVariant) {
+                                                                              bool byVariant,
+                                                                              bool distanceStartsOnly = false) {
   std::vector<std::pair<std::string, std::vector<const StudyCondition*>>> out;
   for (const StudyCondition& c : study.conditions) {
+    if (distanceStartsOnly && c.start != StudyStart::SurfaceDistance) continue;
     const std::string key = byVariant ? fmt::format("{} {}", c.ct, c.variant) : c.ct;
     auto found = std::find_if(out.begin(), out.end(), [&](const auto& g) { return g.first == key; });
     if (found == out.end()) {
@@ -102,11 +104,43 @@ std::string table2Section(const StudyDefinition& study, const std::vector<TrialR
   return text;
 }
 
+/// The capture study's rotation and clinical-setup starts: one row per condition with the initial mean sTRE the
+/// starts actually had. Empty when the study has none.
+std::string otherStartsSection(const StudyDefinition& study, const std::vector<TrialRecord>& records) {
+  std::string rows;
+  for (const StudyCondition& c : study.conditions) {
+    if (c.start == StudyStart::SurfaceDistance) continue;
+    const std::vector<TrialRecord> trials = recordsOf(study, c, records);
+    double initialSum = 0.0, initialMax = 0.0;
+    int initialCount = 0;
+    for (const TrialRecord& r : trials) {
+      if (!std::isfinite(r.initialStre_mm)) continue;
+      initialSum += r.initialStre_mm;
+      initialMax = std::max(initialMax, r.initialStre_mm);
+      ++initialCount;
+    }
+    const ConditionStats s = StudyReport::statistics(trials);
+    const std::string start = c.start == StudyStart::Rotation
+                                  ? fmt::format("rotation {:g}–{:g}°", c.rotationLow_deg, c.rotationHigh_deg)
+                                  : std::string("supine at the isocentre (no landmarks)");
+    rows += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", c.ct, start, s.trials,
+                        initialCount ? mm(initialSum / initialCount) : "–", initialCount ? mm(initialMax) : "–",
+                        percent(s), mm(s.streMeanAll_mm));
+  }
+  if (rows.empty()) return "";
+  return "## Start rotations and the clinical setup alone (both measures)\n\nRotations are about a random axis through "
+         "the bone centre, without translation. The setup start puts the bone centre at the C-arm isocentre with the "
+         "CT axes along the table (SetupPose); its trials differ only by the search seed.\n\n"
+         "| CT | start | trials | initial sTRE mean (mm) | initial sTRE max (mm) | success | final sTRE mean, all (mm) "
+         "|\n|---|---|---|---|---|---|---|\n" +
+         rows + "\n";
+}
+
 std::string captureSection(const StudyDefinition& study, const std::vector<TrialRecord>& records) {
   std::string text = "## Cumulative failure and final error by initial mean sTRE\n\n";
   std::string ranges = "## Capture range (largest initial-sTRE bin edge up to which every bin has >= 95 % success)\n\n"
                        "| CT | measures | capture range (mm) |\n|---|---|---|\n";
-  for (const auto& [name, conditions] : groups(study, true)) {
+  for (const auto& [name, conditions] : groups(study, true, true)) {
     text += fmt::format("### {}\n\n| initial sTRE bin (mm) | trials | success | cumulative failure | final sTRE mean, all "
                         "(mm) | final sTRE max, all (mm) |\n|---|---|---|---|---|---|\n",
                         name);
@@ -130,7 +164,8 @@ std::string captureSection(const StudyDefinition& study, const std::vector<Trial
                           everyBin ? "≥ " : "", range_mm, everyBin ? " (every bin tested)" : "");
   }
   return text + ranges +
-         "\nThe paper reports a capture range of about 55 mm on its lamb hip (Knaan & Joskowicz, MICCAI 2003).\n\n";
+         "\nThe paper reports a capture range of about 55 mm on its lamb hip (Knaan & Joskowicz, MICCAI 2003).\n\n" +
+         otherStartsSection(study, records);
 }
 
 std::string conditionTable(const StudyDefinition& study, const std::vector<TrialRecord>& records, const char* what) {
@@ -184,7 +219,7 @@ std::vector<std::pair<std::string, ChartSpec>> charts(const StudyDefinition& stu
                       "cumulative failure (%)", {}, {}, 0.0, 100.0};
     ChartSpec error{"Final sTRE by initial mean sTRE (all trials)", "initial mean sTRE, upper bin edge (mm)",
                     "final sTRE (mm)", {}, {}, 0.0, 2.0};
-    for (const auto& [name, conditions] : groups(study, true)) {
+    for (const auto& [name, conditions] : groups(study, true, true)) {
       // Cumulative failure: failures over all trials of the bins up to this one.
       ChartSeries cumulative{name, {}, {}};
       int trials = 0, failuresSoFar = 0;

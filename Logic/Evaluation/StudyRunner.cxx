@@ -21,6 +21,7 @@
 #include "Evaluation/StudyCatalog.h"
 #include "Evaluation/StudyXraySource.h"
 #include "Geometry/RigidPose.h"
+#include "InitialPose/SetupPose.h"
 #include "Registration/Registration.h"
 #include "Registration/RegistrationCase.h"
 #include "Simulation/StandardViews.h"
@@ -95,8 +96,20 @@ Status validate(const StudyDefinition& study, const std::vector<StudyCt>& cts, c
       return fail(fmt::format("condition '{}': initial sTRE range {}..{} mm is not a finite range from 0 up", c.name,
                               c.initialLow_mm, c.initialHigh_mm));
     }
+    if (c.start == StudyStart::Rotation && !(c.rotationLow_deg >= 0.0 && c.rotationHigh_deg >= c.rotationLow_deg &&
+                                             c.rotationHigh_deg <= 180.0)) {
+      return fail(fmt::format("condition '{}': start rotation range {}..{} deg is not a range within 0..180 deg",
+                              c.name, c.rotationLow_deg, c.rotationHigh_deg));
+    }
   }
   return Ok{};
+}
+
+/// The cameras of a scene's views.
+std::vector<Camera> cameras(const std::vector<RegistrationView>& views) {
+  std::vector<Camera> out;
+  for (const RegistrationView& v : views) out.push_back(v.camera);
+  return out;
 }
 
 /// The record of a trial that did not register: identification, NaN errors, status Failed and the reason.
@@ -123,9 +136,8 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
                      const std::atomic<bool>* cancel) {
   TrialRecord r = failedTrial(study, c, trial, "");
 
-  SeededRandom random(r.seed ^ 0x5BD1E995u);
-  r.initialTarget_mm = c.initialLow_mm + (c.initialHigh_mm - c.initialLow_mm) * random.uniform01();
-  auto start = PoseOffset::randomAtSurfaceDistance(scene.metrics->surface(), scene.T_truth, r.initialTarget_mm, r.seed);
+  auto start = StudyRunner::startPose(c, scene.metrics->surface(), scene.T_truth, cameras(scene.xrays), r.seed,
+                                      r.initialTarget_mm);
   if (!start) {
     r.reason = "start pose: " + start.error();
     return r;
@@ -353,6 +365,33 @@ Status runTrials(TrialWork& work) {
 }
 
 }  // namespace
+
+Result<Eigen::Isometry3d> StudyRunner::startPose(const StudyCondition& c, const BoneSurface& bone,
+                                                 const Eigen::Isometry3d& T_truth, const std::vector<Camera>& cameras,
+                                                 std::uint32_t seed, double& initialTarget_mm) {
+  SeededRandom random(seed ^ 0x5BD1E995u);
+  switch (c.start) {
+    case StudyStart::SurfaceDistance:
+      initialTarget_mm = c.initialLow_mm + (c.initialHigh_mm - c.initialLow_mm) * random.uniform01();
+      return PoseOffset::randomAtSurfaceDistance(bone, T_truth, initialTarget_mm, seed);
+    case StudyStart::Rotation: {
+      initialTarget_mm = std::numeric_limits<double>::quiet_NaN();
+      const double angle_deg = random.uniform(c.rotationLow_deg, c.rotationHigh_deg);
+      // A uniform random axis: the direction of a 3-D standard normal vector.
+      Eigen::Vector3d axis(random.normal(), random.normal(), random.normal());
+      if (axis.norm() < 1e-12) axis = Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d centre_world_mm = T_truth * bone.centroid_ct_mm();
+      Eigen::Isometry3d rotation = Eigen::Isometry3d::Identity();
+      rotation.linear() = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+      rotation.translation() = centre_world_mm - rotation.linear() * centre_world_mm;
+      return Eigen::Isometry3d(rotation * T_truth);
+    }
+    case StudyStart::SupineSetup:
+      initialTarget_mm = std::numeric_limits<double>::quiet_NaN();
+      return SetupPose::supineAtIsocentre(bone.centroid_ct_mm(), cameras);
+  }
+  return fail("unknown start kind");
+}
 
 Eigen::Isometry3d StudyRunner::truthPose(const BoneSurface& bone) {
   const Eigen::Vector3d centre_ct_mm = bone.centroid_ct_mm();

@@ -76,6 +76,11 @@ class StudyRunner {
   /// Sets every condition's usedSliceSpacing_mm: the slice spacing of the CT it registers on (its scenario's spacing,
   /// or the CT's own when that is already as coarse). Conditions naming a CT not in `cts` are left at 0.
   static void resolveSliceSpacings(StudyDefinition& study, const std::vector<StudyCt>& cts);
+  /// The start pose of a trial of condition `c` (its StudyStart) for the bone at T_truth seen by `cameras`, from the
+  /// trial's seed; initialTarget_mm gets the mean surface distance asked for (NaN for rotation and setup starts).
+  static Result<Eigen::Isometry3d> startPose(const StudyCondition& c, const BoneSurface& bone,
+                                             const Eigen::Isometry3d& T_truth, const std::vector<Camera>& cameras,
+                                             std::uint32_t seed, double& initialTarget_mm);
   /// The true pose T_world_from_ct used for a CT with this bone (see the file comment).
   static Eigen::Isometry3d truthPose(const BoneSurface& bone);
   /// `base` with every stage's metric set for `measures` (NCC only, VLNC only, or unchanged).

@@ -34,11 +34,20 @@ TEST(StudyCatalog, Table2CrossesTheThreeScenariosWithTheCts) {
   EXPECT_DOUBLE_EQ(study.conditions[0].initialHigh_mm, 10.0);
 }
 
-TEST(StudyCatalog, CaptureBinsCoverZeroToSixtyMillimetres) {
+TEST(StudyCatalog, CaptureBinsCoverZeroToAHundredMillimetresThirtyDegreesAndTheSetupStart) {
   const auto study = fct::StudyCatalog::define("capture", false, {"pelvis"}).value();
-  ASSERT_EQ(study.conditions.size(), 18u);  // 3 measure sets x 6 bins
+  ASSERT_EQ(study.conditions.size(), 34u);  // 3 measure sets x 10 distance bins, 3 rotation bins, the setup start
   EXPECT_DOUBLE_EQ(study.conditions.front().initialLow_mm, 0.0);
-  EXPECT_DOUBLE_EQ(study.conditions[5].initialHigh_mm, 60.0);
+  EXPECT_DOUBLE_EQ(study.conditions[9].initialHigh_mm, 100.0);
+  for (int b = 0; b < 3; ++b) {
+    const fct::StudyCondition& c = study.conditions[30 + static_cast<std::size_t>(b)];
+    EXPECT_EQ(c.start, fct::StudyStart::Rotation) << c.name;
+    EXPECT_DOUBLE_EQ(c.rotationLow_deg, 10.0 * b) << c.name;
+    EXPECT_DOUBLE_EQ(c.rotationHigh_deg, 10.0 * (b + 1)) << c.name;
+    EXPECT_EQ(c.measures, fct::StudyMeasures::Both) << c.name;
+  }
+  EXPECT_EQ(study.conditions.back().start, fct::StudyStart::SupineSetup);
+  EXPECT_EQ(study.conditions.back().name, "pelvis/both/supine-setup");
 }
 
 TEST(StudyCatalog, AblationWithSiddonReportsTheTransgraphGapInsteadOfARow) {

@@ -5,6 +5,8 @@
 #include "Evaluation/StudyCatalog.h"
 #include "Evaluation/StudyRunner.h"
 #include "Evaluation/StudyXraySource.h"
+#include "InitialPose/SetupPose.h"
+#include "Simulation/StandardViews.h"
 #include "TestSupport.h"
 
 namespace {
@@ -17,7 +19,50 @@ fct::Volume tinyCt(double sliceSpacing_mm) {
   return ct;
 }
 
+/// Cameras of the three standard views around the world origin.
+std::vector<fct::Camera> standardCameras() {
+  std::vector<fct::Camera> cameras;
+  fct::StandardViewOptions options;
+  options.count = 3;
+  for (const fct::ViewSpec& view : fct::StandardViews::build(Eigen::Vector3d::Zero(), options).value()) {
+    cameras.push_back(view.camera);
+  }
+  return cameras;
+}
+
 }  // namespace
+
+TEST(StudyRunner, StartPosesRotateAboutTheBoneCentreWithinTheBinOrComeFromTheSupineSetup) {
+  const fct::Volume ct = tinyCt(1.0);
+  const fct::BoneSurface bone = fct::BoneSurface::extract(ct).value();
+  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(bone);
+  const std::vector<fct::Camera> cameras = standardCameras();
+  fct::StudyCondition c;
+  c.start = fct::StudyStart::Rotation;
+  c.rotationLow_deg = 20.0;
+  c.rotationHigh_deg = 30.0;
+  for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+    double target_mm = 0.0;
+    const Eigen::Isometry3d T_start = fct::StudyRunner::startPose(c, bone, T_truth, cameras, seed, target_mm).value();
+    const double angle_deg =
+        Eigen::AngleAxisd(T_start.linear() * T_truth.linear().transpose()).angle() * 180.0 / M_PI;
+    EXPECT_GE(angle_deg, 20.0 - 1e-9) << "seed " << seed;
+    EXPECT_LE(angle_deg, 30.0 + 1e-9) << "seed " << seed;
+    // The bone centre stays where it is.
+    EXPECT_LT((T_start * bone.centroid_ct_mm() - T_truth * bone.centroid_ct_mm()).norm(), 1e-9) << "seed " << seed;
+    EXPECT_TRUE(std::isnan(target_mm));
+  }
+  c.start = fct::StudyStart::SupineSetup;
+  double target_mm = 0.0;
+  const Eigen::Isometry3d T_setup = fct::StudyRunner::startPose(c, bone, T_truth, cameras, 7, target_mm).value();
+  const Eigen::Isometry3d T_expected = fct::SetupPose::supineAtIsocentre(bone.centroid_ct_mm(), cameras).value();
+  EXPECT_TRUE(T_setup.isApprox(T_expected, 1e-12));
+  EXPECT_TRUE(T_setup.linear().isIdentity(1e-12)) << "supine: CT axes along the world's";
+  c.start = fct::StudyStart::SurfaceDistance;
+  c.initialLow_mm = c.initialHigh_mm = 12.0;
+  fct::StudyRunner::startPose(c, bone, T_truth, cameras, 7, target_mm).value();
+  EXPECT_DOUBLE_EQ(target_mm, 12.0);
+}
 
 TEST(StudyRunner, ScheduleForMeasuresKeepsOrReplacesEveryStageMetric) {
   const fct::RegistrationSchedule base = fct::RegistrationSchedule::builtin("fast").value();
@@ -53,6 +98,13 @@ TEST(StudyRunner, BadStudiesFailBeforeAnyTrial) {
   const auto sixViews = fct::StudyRunner::run(study, cts, store);
   ASSERT_FALSE(sixViews.ok());
   EXPECT_NE(sixViews.error().find("6 views"), std::string::npos) << sixViews.error();
+  study.conditions.front().viewCount = 3;
+  study.conditions.front().start = fct::StudyStart::Rotation;
+  study.conditions.front().rotationLow_deg = 30.0;
+  study.conditions.front().rotationHigh_deg = 10.0;
+  const auto badRotation = fct::StudyRunner::run(study, cts, store);
+  ASSERT_FALSE(badRotation.ok());
+  EXPECT_NE(badRotation.error().find("start rotation range 30..10 deg"), std::string::npos) << badRotation.error();
   EXPECT_TRUE(store.records().empty());
 }
 
