@@ -43,7 +43,7 @@ struct EvaluateOptions {
   int jobs = 1;
   int trials = 0;  ///< > 0: at most this many trials per condition
   std::vector<std::string> cts;
-  std::string preset;    ///< empty: the study's (paper; quick: fast)
+  std::string preset;    ///< empty: the study's (clinical; quick: fast)
   std::string detector;  ///< COLSxROWS; empty: the study's
   double pixel_mm = 0.0; ///< > 0: detector pixel size
   std::string method = "siddon";
@@ -347,7 +347,7 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
                       "CT volume(s) or DICOM folder(s) instead of the defaults (full: the pelvis of $FLUOROCT_DATA_DIR, "
                       "plus its head phantom for table2; quick: the phantom)");
   command->add_option("--preset", options->preset,
-                      "Registration preset: paper, fast or a preset FILE.json (default: paper; --quick: fast)");
+                      "Registration preset: clinical, paper, fast or a preset FILE.json (default: clinical, the product default; --quick: fast)");
   command->add_option("--detector", options->detector,
                       "Detector size in pixels, COLSxROWS (default 800x600; --quick 128x128); the field is COLS x "
                       "--pixel-mm wide, as in `fluoroct views`");

@@ -8,7 +8,7 @@
 //             registers with the study's DRR method; with the transgraph method a "no-transgraph" row (exact Siddon
 //             DRRs, no tables) is added; with another method the Transgraph is off in every row, said as a gap.
 // - views:    1 to 5 views, 10 mm starts.
-// Full studies use the "paper" preset and an 800 x 600 detector at 0.4 mm; quick ones the "fast" preset, a 128 x 128
+// Full studies use the default preset (RegistrationSchedule::kDefaultPreset) and an 800 x 600 detector at 0.4 mm; quick ones the "fast" preset, a 128 x 128
 // detector at 2.4 mm, Transgraph tables at a 6 mm step and 2 trials per condition (a few minutes in all, for CI).
 
 #include <string>

@@ -52,7 +52,7 @@ struct StudyCondition {
 
 /// The setup shared by all conditions of a study.
 struct StudySetup {
-  std::string preset = "paper";   ///< registration schedule (RegistrationSchedule::resolve)
+  std::string preset = RegistrationSchedule::kDefaultPreset;  ///< registration schedule (RegistrationSchedule::resolve)
   StandardViewOptions detector;   ///< C-arm geometry and detector (its count is ignored: conditions choose)
   std::uint32_t seed = 1;         ///< base seed: trial t of every condition starts from seed + t
   DrrMethod method = DrrMethod::Siddon;  ///< DRR method of the registrations (a condition's ablation may switch the

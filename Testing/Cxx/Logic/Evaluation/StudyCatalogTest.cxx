@@ -18,7 +18,7 @@ TEST(StudyCatalog, EveryStudyDefinesUniqueConditionsPerCt) {
         EXPECT_LE(c.initialLow_mm, c.initialHigh_mm);
       }
       EXPECT_EQ(cts.size(), 2u) << name;
-      EXPECT_EQ(study.value().setup.preset, quick ? "fast" : "paper");
+      EXPECT_EQ(study.value().setup.preset, quick ? "fast" : fct::RegistrationSchedule::kDefaultPreset);
     }
   }
 }
