@@ -54,6 +54,7 @@ struct Options {
   bool noMetalMask = false;
   double metalMinExcess = MetalMaskOptions{}.minExcess;
   double cutFaceMargin_mm = RegistrationCaseOptions{}.cutFaceMargin_mm;
+  double rayCastStep_mm = DrrRendererOptions{}.rayCastStep_mm;
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
   std::string dicomReg;  ///< optional DICOM Spatial Registration object (REG) of the final pose
   RegistrationAblation ablation;
@@ -203,6 +204,7 @@ class ProgressBar {
 RegistrationCaseOptions caseOptionsFor(const Options& o, const Inputs& in) {
   RegistrationCaseOptions options;
   options.drr.method = in.method;
+  options.drr.rayCastStep_mm = o.rayCastStep_mm;
   options.drr.transgraph.spacing_mm = o.transgraphSpacing_mm;
   if (o.transgraphCache == "none") {
     options.drr.transgraphCacheFolder = std::nullopt;
@@ -342,7 +344,8 @@ nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r,
                                  {"field_of_view_detection", !o.noFieldOfView},
                                  {"metal_mask", !o.noMetalMask},
                                  {"metal_min_excess", o.metalMinExcess},
-                                 {"cut_face_margin_mm", o.cutFaceMargin_mm}};
+                                 {"cut_face_margin_mm", o.cutFaceMargin_mm},
+                                 {"raycast_step_mm", o.rayCastStep_mm}};
   for (const auto& item : json["options"].items()) options[item.key()] = item.value();
   json["options"] = std::move(options);
   json["transgraph"] = std::move(transgraph);
@@ -507,6 +510,10 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--method", options->method,
                       "DRR method: siddon (exact), raycast (trilinear) or transgraph (one precomputed ray table per "
                       "view around the initial pose, cached on disk; rays outside it are exact)")
+      ->capture_default_str();
+  command->add_option("--raycast-step-mm", options->rayCastStep_mm,
+                      "raycast method: sampling step along each ray in mm; 0 = half the smallest voxel spacing")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command->add_option("--transgraph-cache", options->transgraphCache,
                       "Folder of the transgraph table cache (default: $XDG_CACHE_HOME/fluoroct/transgraph or "

@@ -191,6 +191,26 @@ TEST(RegisterCommand, RegistersWithTransgraphTablesCachedForTheNextRun) {
   EXPECT_EQ(result.value()["options"]["ablation"][2], "no-ct-pyramid");
 }
 
+TEST(RegisterCommand, RegistersWithTrilinearDrrsAtTheChosenStep) {
+  const fs::path dir = fct::test::scratchDir();
+  const Eigen::Isometry3d truth = makeCase(dir);
+  ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
+  const auto run = fct::test::runCli(fmt::format(
+      "register --ct '{}' --views '{}' --init '{}' --preset fast --seed 3 --method raycast --raycast-step-mm 2 "
+      "--out '{}'",
+      (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(), (dir / "init.json").string(),
+      (dir / "result.json").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("raycast method"), std::string::npos) << run.out;
+  auto result = fct::JsonDocument::parse(dir / "result.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  EXPECT_EQ(result.value()["options"]["method"], "raycast");
+  EXPECT_DOUBLE_EQ(result.value()["options"]["raycast_step_mm"].get<double>(), 2.0);
+  auto registered = fct::PoseFile::read(dir / "result.json");
+  ASSERT_TRUE(registered.ok()) << registered.error();
+  EXPECT_LT((registered.value().translation() - truth.translation()).norm(), 1.0);
+}
+
 TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
   const fs::path dir = fct::test::scratchDir();
   const Eigen::Isometry3d truth = makeCase(dir);
@@ -209,6 +229,10 @@ TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
 
   const auto badMethod = fct::test::runCli(base + init + " --method magic");
   EXPECT_TRUE(oneErrorLine(badMethod)) << badMethod.err;
+
+  const auto badStep = fct::test::runCli(base + init + " --method raycast --raycast-step-mm -1");
+  EXPECT_TRUE(oneErrorLine(badStep)) << badStep.err;
+  EXPECT_NE(badStep.err.find("--raycast-step-mm"), std::string::npos) << badStep.err;
 
   const auto badMetal = fct::test::runCli(base + init + " --metal-min-excess 0");
   EXPECT_TRUE(oneErrorLine(badMetal)) << badMetal.err;
