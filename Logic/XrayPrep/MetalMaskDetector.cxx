@@ -94,8 +94,9 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) || !std::isfinite(o.growExcess) ||
       !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) || o.dilation_px < 0) {
     return fail(fmt::format("metal detection options: assumed pixel spacing {} mm, windows ({}, {}, {} mm), "
-                            "excesses (minimum {}, dense {}, very dense {}), contrast ratios ({}, {}, {}) and sagitta {} mm must be > 0; lengths ({}, {}, "
-                            "{} mm), growth distance {} mm and dilation {} px >= 0; fix the settings",
+                            "minimum excess {}, dense and very dense excesses ({}, {}), contrast ratios ({}, {}, {}) "
+                            "and sagitta {} mm must be > 0; lengths ({}, {}, {} mm), growth distance {} mm and "
+                            "dilation {} px >= 0; fix the settings",
                             o.assumedPixelSpacing_mm, o.backgroundWindow_mm, o.narrowWindow_mm,
                             o.contrastWindow_mm, o.minExcess, o.denseExcess, o.veryDenseExcess,
                             o.maxContrastRatio, o.seedContrastRatio, o.denseContrastRatio, o.maxSagitta_mm,
