@@ -3,8 +3,9 @@
 // phantom and, when ../shared/data is there, of the head phantom and pelvis CTs: it removes less than 0.5 % of each
 // metal-free view, and covers most of the pixels of K-wires and screws that are not in the CT (the pixels whose
 // line integral the tools raise by more than 0.5 over the metal-free view with the same noise). The per-view table of
-// docs/evaluation.md comes from the disabled MetalMaskStudy test (both CTs, also at 0.8 mm pixels; about 5 min). The real shoulder fluoroscopy's
-// K-wire stays disabled: the contrast-processed image's wire stands only ~0.5 above its surroundings.
+// docs/evaluation.md comes from the disabled MetalMaskStudy test (both CTs, also at 0.8 mm pixels; about 5 min). The
+// real shoulder fluoroscopy's K-wire stays disabled: the contrast-processed image's wire stands only ~0.5 above its
+// surroundings.
 #include <gtest/gtest.h>
 
 #include <algorithm>
