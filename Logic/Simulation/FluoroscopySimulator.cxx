@@ -463,6 +463,23 @@ Result<FloatImage> FluoroscopySimulator::render(const Volume& ct, const Camera& 
   return std::move(view.value().image);
 }
 
+Result<std::vector<FloatImage>> FluoroscopySimulator::renderViews(const Volume& ct, const std::vector<Camera>& cameras,
+                                                                 const Eigen::Isometry3d& T_world_from_ct,
+                                                                 const FluoroscopyOptions& options,
+                                                                 std::uint32_t firstViewSeed) {
+  if (Status rigid = checkRigid(T_world_from_ct); !rigid) return fail(rigid.error());
+  auto scene = prepareScene(&ct, options);
+  if (!scene.ok()) return fail(scene.error());
+  std::vector<FloatImage> images;
+  for (std::size_t n = 0; n < cameras.size(); ++n) {
+    auto view = renderView(scene.value(), cameras[n], T_world_from_ct, options,
+                           firstViewSeed + static_cast<std::uint32_t>(n));
+    if (!view.ok()) return fail(fmt::format("view {}: {}", n, view.error()));
+    images.push_back(std::move(view.value().image));
+  }
+  return images;
+}
+
 Result<FloatImage> FluoroscopySimulator::renderGridPlate(const Camera& camera, const FluoroscopyOptions& options,
                                                          std::uint32_t viewSeed) {
   if (!(options.gridPitch_mm > 0.0)) {

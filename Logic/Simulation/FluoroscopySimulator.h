@@ -96,6 +96,12 @@ class FluoroscopySimulator {
   static Result<FloatImage> render(const Volume& ct, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
                                    const FluoroscopyOptions& options, std::uint32_t viewSeed);
 
+  /// render() of each camera (view n with noise seed firstViewSeed + n; the same objects in every view), preparing the
+  /// patient once. Fails as render() does.
+  static Result<std::vector<FloatImage>> renderViews(const Volume& ct, const std::vector<Camera>& cameras,
+                                                     const Eigen::Isometry3d& T_world_from_ct,
+                                                     const FluoroscopyOptions& options, std::uint32_t firstViewSeed);
+
   /// Image of the dewarp calibration plate alone (no patient, no calibration spheres; beads of
   /// options.gridBeadRadius_mm at options.gridPitch_mm, centred on the principal ray) seen by `camera` through the
   /// same beam, noise (viewSeed), blur, intensifier distortion and detector response as render(). Fails on a

@@ -1,12 +1,74 @@
 #include "XrayPrep/MetalMaskDetector.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 namespace fct {
+
+namespace {
+
+constexpr float kHigh = std::numeric_limits<float>::max();
+
+/// Grey-level opening of `p` (invalid pixels hold kHigh) with a square window of `side` px, over the valid pixels
+/// only: invalid pixels never win the erosion (+max) nor, where the whole erosion window was invalid, the dilation.
+cv::Mat validOpening(const cv::Mat& p, int side) {
+  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side | 1, side | 1));
+  cv::Mat background;
+  cv::erode(p, background, window, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(kHigh));
+  background.setTo(cv::Scalar(-kHigh), background == kHigh);
+  cv::dilate(background, background, window, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(-kHigh));
+  return background;
+}
+
+/// Dilation of a 0/nonzero mask by a square of radius `radius_px`.
+cv::Mat grown(const cv::Mat& mask, int radius_px) {
+  cv::Mat out;
+  const int side = 2 * radius_px + 1;
+  cv::dilate(mask, out, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side)));
+  return out;
+}
+
+/// Shape and contrast of one connected piece of candidate pixels.
+struct Piece {
+  std::vector<cv::Point> pixels;
+  double wideExcessSum = 0.0;
+  double contrastRatioSum = 0.0;
+};
+
+/// Sagitta in px of a parabola fitted (least squares) to the piece's pixels across its fitted straight axis, over the
+/// piece's length: 0 for a straight bar of any width, the bow of an arc.
+double sagitta_px(const std::vector<cv::Point>& pixels) {
+  if (pixels.size() < 3) return 0.0;
+  cv::Vec4f line;
+  cv::fitLine(pixels, line, cv::DIST_L2, 0, 0.01, 0.01);
+  const int n = static_cast<int>(pixels.size());
+  cv::Mat design(n, 3, CV_64F);
+  cv::Mat across(n, 1, CV_64F);
+  double tMin = std::numeric_limits<double>::max();
+  double tMax = std::numeric_limits<double>::lowest();
+  for (int i = 0; i < n; ++i) {
+    const double dx = pixels[static_cast<std::size_t>(i)].x - line[2];
+    const double dy = pixels[static_cast<std::size_t>(i)].y - line[3];
+    const double t = dx * line[0] + dy * line[1];
+    design.at<double>(i, 0) = t * t;
+    design.at<double>(i, 1) = t;
+    design.at<double>(i, 2) = 1.0;
+    across.at<double>(i) = -dx * line[1] + dy * line[0];
+    tMin = std::min(tMin, t);
+    tMax = std::max(tMax, t);
+  }
+  cv::Mat coefficients;
+  if (!cv::solve(design, across, coefficients, cv::DECOMP_SVD)) return 0.0;
+  const double halfLength = 0.5 * (tMax - tMin);
+  return std::abs(coefficients.at<double>(0)) * halfLength * halfLength;
+}
+
+}  // namespace
 
 Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, const ValidMask& mask,
                                             double pixelSpacing_mm) const {
@@ -23,40 +85,104 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
     return fail(fmt::format("metal detection: pixel spacing {} mm; give a positive spacing or 0 for unknown",
                             pixelSpacing_mm));
   }
-  const int window_px = pixelSpacing_mm > 0.0
-                            ? static_cast<int>(std::lround(o.backgroundWindow_mm / pixelSpacing_mm))
-                            : o.backgroundWindow_px;
-  if (window_px < 3 || !(o.minExcess > 0.0) || !std::isfinite(o.minExcess) || o.dilation_px < 0) {
-    return fail(fmt::format("metal detection options: window {} px (>= 3; {} mm at {} mm pixels), minimum excess {} "
-                            "(> 0), dilation {} px (>= 0); fix the settings",
-                            window_px, o.backgroundWindow_mm, pixelSpacing_mm, o.minExcess, o.dilation_px));
+  const double spacing_mm = pixelSpacing_mm > 0.0 ? pixelSpacing_mm : o.assumedPixelSpacing_mm;
+  const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  if (!positive(spacing_mm) || !positive(o.backgroundWindow_mm) || !positive(o.narrowWindow_mm) ||
+      !positive(o.contrastWindow_mm) || !positive(o.minExcess) || !positive(o.maxContrastRatio) ||
+      !positive(o.maxSagitta_mm) || !positive(o.seedContrastRatio) || !positive(o.denseExcess) ||
+      !positive(o.denseContrastRatio) || !positive(o.veryDenseExcess) || !(o.minLength_mm >= 0.0) ||
+      !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) || !std::isfinite(o.growExcess) ||
+      !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) || o.dilation_px < 0) {
+    return fail(fmt::format("metal detection options: assumed pixel spacing {} mm, windows ({}, {}, {} mm), "
+                            "minimum excess {}, dense and very dense excesses ({}, {}), contrast ratios ({}, {}, {}) "
+                            "and sagitta {} mm must be > 0; lengths ({}, {}, {} mm), growth distance {} mm and "
+                            "dilation {} px >= 0; fix the settings",
+                            o.assumedPixelSpacing_mm, o.backgroundWindow_mm, o.narrowWindow_mm,
+                            o.contrastWindow_mm, o.minExcess, o.denseExcess, o.veryDenseExcess,
+                            o.maxContrastRatio, o.seedContrastRatio, o.denseContrastRatio, o.maxSagitta_mm,
+                            o.minLength_mm, o.minDenseLength_mm, o.minVeryDenseLength_mm, o.growDistance_mm,
+                            o.dilation_px));
   }
+  const auto toPixels = [spacing_mm](double length_mm) {
+    return static_cast<int>(std::lround(length_mm / spacing_mm));
+  };
+  // Windows of at least 3 px, the wide one at least the narrow one.
+  const int narrowWindow_px = std::max(3, toPixels(o.narrowWindow_mm));
+  const int wideWindow_px = std::max(narrowWindow_px, toPixels(o.backgroundWindow_mm));
+  const int contrastWindow_px = std::max(3, toPixels(o.contrastWindow_mm));
   for (float p : lineIntegrals.pixels) {
     if (!std::isfinite(p)) return fail("metal detection: the line-integral image has non-finite pixels");
   }
   try {
-    // Opening over the valid pixels only: invalid pixels never win the erosion (+max) nor, where the whole erosion
-    // window was invalid, the dilation (-max).
-    constexpr float kHigh = std::numeric_limits<float>::max();
-    cv::Mat p(rows, cols, CV_32F);
-    for (std::size_t i = 0; i < mask.valid.size(); ++i) {
-      p.ptr<float>()[i] = mask.valid[i] ? lineIntegrals.pixels[i] : kHigh;
-    }
-    const int side = window_px | 1;
-    const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side));
-    cv::Mat background;
-    cv::erode(p, background, window, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(kHigh));
-    background.setTo(cv::Scalar(-kHigh), background == kHigh);
-    cv::dilate(background, background, window, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(-kHigh));
+    const cv::Mat image(rows, cols, CV_32F, const_cast<float*>(lineIntegrals.pixels.data()));
+    const cv::Mat valid(rows, cols, CV_8U, const_cast<std::uint8_t*>(mask.valid.data()));
+    cv::Mat p = image.clone();
+    p.setTo(cv::Scalar(kHigh), valid == 0);
+    const cv::Mat wideExcess = image - validOpening(p, wideWindow_px);
+    const cv::Mat narrowBackground = validOpening(p, narrowWindow_px);
+    const cv::Mat narrowExcess = image - narrowBackground;
+    // The low side of the surroundings: the erosion over a disc (invalid pixels never win it).
+    cv::Mat lowSide;
+    const int disc = contrastWindow_px | 1;
+    cv::erode(p, lowSide, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(disc, disc)), cv::Point(-1, -1), 1,
+              cv::BORDER_CONSTANT, cv::Scalar(kHigh));
+    cv::Mat contrast = narrowBackground - lowSide;
+    contrast.setTo(cv::Scalar(0.0f), lowSide == kHigh);
 
-    cv::Mat metal = cv::Mat::zeros(rows, cols, CV_8U);
-    for (std::size_t i = 0; i < mask.valid.size(); ++i) {
-      if (mask.valid[i] && lineIntegrals.pixels[i] - background.ptr<float>()[i] > o.minExcess) metal.data[i] = 1;
+    const auto minExcess = static_cast<float>(o.minExcess);
+    cv::Mat candidates = cv::Mat::zeros(rows, cols, CV_8U);
+    cv::Mat growable = cv::Mat::zeros(rows, cols, CV_8U);
+    for (int i = 0; i < rows * cols; ++i) {
+      if (!valid.data[i]) continue;
+      const float wide = wideExcess.ptr<float>()[i];
+      const float narrow = narrowExcess.ptr<float>()[i];
+      if (wide > minExcess && narrow > static_cast<float>(o.growExcess)) growable.data[i] = 1;
+      if (wide > minExcess && narrow > minExcess &&
+          contrast.ptr<float>()[i] < static_cast<float>(o.maxContrastRatio) * narrow) {
+        candidates.data[i] = 1;
+      }
     }
-    if (o.dilation_px > 0) {
-      const int grow = 2 * o.dilation_px + 1;
-      cv::dilate(metal, metal, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(grow, grow)));
+
+    cv::Mat labels;
+    const int labelCount = cv::connectedComponents(candidates, labels, 8, CV_32S);
+    std::vector<Piece> pieces(static_cast<std::size_t>(labelCount));
+    for (int i = 0; i < rows * cols; ++i) {
+      const int label = labels.ptr<int>()[i];
+      if (label == 0) continue;
+      Piece& piece = pieces[static_cast<std::size_t>(label)];
+      piece.pixels.emplace_back(i % cols, i / cols);
+      piece.wideExcessSum += wideExcess.ptr<float>()[i];
+      piece.contrastRatioSum += contrast.ptr<float>()[i] / narrowExcess.ptr<float>()[i];
     }
+    cv::Mat seeds = cv::Mat::zeros(rows, cols, CV_8U);
+    for (std::size_t label = 1; label < pieces.size(); ++label) {
+      const Piece& piece = pieces[label];
+      const double count = static_cast<double>(piece.pixels.size());
+      const cv::RotatedRect box = cv::minAreaRect(piece.pixels);
+      const double length_mm = (std::max(box.size.width, box.size.height) + 1.0) * spacing_mm;
+      const double wide = piece.wideExcessSum / count;
+      const double ratio = piece.contrastRatioSum / count;
+      // Very dense pieces need no shape test (crossing wires make an X); the others must be straight.
+      const bool veryDense = wide >= o.veryDenseExcess && length_mm >= o.minVeryDenseLength_mm;
+      const bool longThin = length_mm >= o.minLength_mm && ratio < o.seedContrastRatio;
+      const bool dense = wide >= o.denseExcess && length_mm >= o.minDenseLength_mm && ratio < o.denseContrastRatio;
+      if (veryDense || ((longThin || dense) && sagitta_px(piece.pixels) * spacing_mm <= o.maxSagitta_mm)) {
+        for (const cv::Point& pixel : piece.pixels) seeds.at<std::uint8_t>(pixel) = 1;
+      }
+    }
+
+    // Geodesic growth of the seeds inside the growable pixels, one 3x3 step per pixel of distance.
+    cv::Mat metal = seeds.clone();
+    const cv::Mat step = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+    for (int s = 0, steps = toPixels(o.growDistance_mm); s < steps; ++s) {
+      cv::Mat next;
+      cv::dilate(metal, next, step);
+      next &= growable;
+      next |= seeds;
+      if (cv::countNonZero(next != metal) == 0) break;
+      metal = next;
+    }
+    if (o.dilation_px > 0) metal = grown(metal, o.dilation_px);
     MetalMask result{mask, 0};
     for (std::size_t i = 0; i < mask.valid.size(); ++i) {
       if (metal.data[i] && result.mask.valid[i]) {

@@ -2,15 +2,26 @@
 // MetalMaskDetector: finds the shadows of metal (K-wires, screws, plates, instruments) in an X-ray so they can be
 // excluded from the comparison with the DRR, which the CT cannot explain.
 //
-// Method, on the image in the line-integral sense (XrayIntensityModel: p = -ln(I/I0), bone bright): metal is much
-// more attenuating than bone and is thin, so it stands out as a narrow ridge of p far above its surroundings. The
-// background is the grey-level opening of p over the valid pixels only (erosion then dilation with a square window
-// wider than any wire, screw or plate shadow but narrower than bones: backgroundWindow_mm on the detector when the
-// pixel spacing is known, else backgroundWindow_px); the excess p - opening(p) >= 0 is the attenuation
-// a narrow object adds on top of its surroundings. A pixel is metal where the excess exceeds minExcess (dimensionless
-// line-integral units: exp(-1.5) = 22 % of the neighbourhood's signal reaches the detector, which bone edges of a
-// patient do not produce but steel and titanium of a few mm do). The metal pixels are dilated by dilation_px to
-// cover the blurred edge of the shadow. Objects wider than the window are not found.
+// Method, on the image in the line-integral sense (XrayIntensityModel: p = -ln(I/I0), bone bright), over the valid
+// pixels only; every length is in mm on the detector (pixel counts follow the pixel spacing):
+// - a tool adds a step of line integral over its surroundings on both sides. Two grey-level openings estimate the
+//   surroundings: a wide one (backgroundWindow_mm, wider than any wire, screw or plate shadow) and a narrow one
+//   (narrowWindow_mm, a little wider than a wire or a screw shaft); a candidate pixel stands more than minExcess above
+//   both. Bone seen edge-on (the skull's tangent rim, a cortex) can stand as high, but it is one-sided: the
+//   surroundings are the bone on one side and the soft tissue beyond it on the other. The local bone contrast is the
+//   narrow opening minus the erosion over a disc of contrastWindow_mm; a candidate must stand above it by
+//   1 / maxContrastRatio at least;
+// - the candidates' connected pieces are tested as shapes. A piece seeds the metal when it is very dense (mean wide
+//   excess >= veryDenseExcess, length >= minVeryDenseLength_mm), or when it is straight (the sagitta of a parabola
+//   fitted across the piece's axis is at most maxSagitta_mm: a rim is an arc) and either long with little bone
+//   contrast (length >= minLength_mm, mean contrast / narrow excess < seedContrastRatio) or dense (mean wide excess
+//   >= denseExcess, length >= minDenseLength_mm, mean ratio < denseContrastRatio);
+// - the seeds grow along connected pixels still minExcess above the wide and growExcess above the narrow surroundings
+//   for up to growDistance_mm (the rest of a wire over dense bone, a screw head), and the result is dilated by
+//   dilation_px to cover the blurred edge of the shadow.
+// Not found: objects wider than the wide window, curved or crossing metal that is not very dense, metal
+// that stands less than minExcess above its surroundings (contrast-processed images; thin wires over thick anatomy
+// at coarse pixels).
 
 #include <cstddef>
 
@@ -20,12 +31,25 @@
 
 namespace fct {
 
-/// Settings of the metal detection (full-resolution pixels).
+/// Settings of the metal detection (lengths in mm on the detector; excesses in line-integral units).
 struct MetalMaskOptions {
-  double backgroundWindow_mm = 30.0;  ///< side of the square opening window on the detector (plate shadow ~20 mm)
-  int backgroundWindow_px = 75;       ///< the window side in pixels when the detector pixel spacing is unknown
-  double minExcess = 1.5;        ///< line-integral excess over the local background above which a pixel is metal
-  int dilation_px = 3;           ///< metal pixels are grown by this radius (square) before exclusion
+  double backgroundWindow_mm = 30.0;  ///< side of the wide square opening window (plate shadow ~20 mm)
+  double narrowWindow_mm = 10.0;      ///< side of the narrow square opening window (screw shaft ~7 mm)
+  double contrastWindow_mm = 30.0;    ///< diameter of the erosion disc that finds the low side of the surroundings
+  double assumedPixelSpacing_mm = 0.4;  ///< pixel spacing used when the image's is unknown
+  double minExcess = 1.0;             ///< a candidate stands this far above the wide and the narrow opening
+  double maxContrastRatio = 0.7;      ///< a candidate's bone contrast is below this fraction of its narrow excess
+  double maxSagitta_mm = 1.5;         ///< a piece bends at most this much from a straight line
+  double minLength_mm = 15.0;         ///< a long piece seeds metal when its mean contrast ratio is below ...
+  double seedContrastRatio = 0.5;     ///< ... this
+  double denseExcess = 2.3;           ///< a piece with this mean wide excess seeds metal when ...
+  double minDenseLength_mm = 10.0;    ///< ... at least this long and ...
+  double denseContrastRatio = 0.6;    ///< ... its mean contrast ratio is below this
+  double veryDenseExcess = 3.0;       ///< a piece with this mean wide excess seeds metal when ...
+  double minVeryDenseLength_mm = 2.0;  ///< ... at least this long
+  double growExcess = 0.5;            ///< seeds grow into pixels this far above the narrow opening ...
+  double growDistance_mm = 25.0;      ///< ... up to this far
+  int dilation_px = 3;                ///< metal pixels are grown by this radius (square) before exclusion
 };
 
 /// What was found.
@@ -40,8 +64,8 @@ class MetalMaskDetector {
   explicit MetalMaskDetector(MetalMaskOptions options = {}) : m_options(options) {}
 
   /// The metal mask of `lineIntegrals` (p = -ln(I/I0), >= 0) over the pixels valid in `mask`; `pixelSpacing_mm` is
-  /// the detector pixel size (0 = unknown: the window is backgroundWindow_px). Fails on a size mismatch, bad options
-  /// or spacing, non-finite pixels, or an OpenCV error.
+  /// the detector pixel size (0 = unknown: assumedPixelSpacing_mm). Fails on a size mismatch, bad options or
+  /// spacing, non-finite pixels, or an OpenCV error.
   Result<MetalMask> detect(const FloatImage& lineIntegrals, const ValidMask& mask, double pixelSpacing_mm = 0.0) const;
 
  private:

@@ -1,5 +1,6 @@
 // MetalMaskDetector: a dark (high line integral) thin bar is masked with its dilation, smooth bone and its edges are
-// not, invalid pixels stay invalid and are not counted, a clean image loses nothing, and bad input fails.
+// not, nor a skull-like rim as dense as the bar, invalid pixels stay invalid and are not counted, a clean image loses
+// nothing, and bad input fails.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -40,6 +41,28 @@ TEST(MetalMaskDetector, MasksDarkBarWithDilationButNotBone) {
   EXPECT_EQ(metal.value().metalPixelCount, static_cast<std::size_t>((3 + 4) * (80 + 4)));
 }
 
+TEST(MetalMaskDetector, OneSidedCurvedRimIsBoneNotMetal) {
+  // At 1 mm pixels, a skull seen tangentially: outside the skull 0.2, inside 1.3, and along the inner surface (a circle
+  // of radius 100 px) a rim standing 1.5 above the inside and 2.6 above the outside, as dense as the straight 3 px bar
+  // beside it (adding 2.0 over 60 mm). The bar is metal, no pixel of the rim is.
+  fct::FloatImage image = fct::FloatImage::filled(200, 120, 0.0f);
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) {
+      const double r = std::hypot(col - 100.0, row - 150.0);
+      image.at(col, row) = static_cast<float>(0.2 + 1.1 / (1.0 + std::exp((r - 100.0) / 1.0)) +
+                                              1.5 * std::exp(-0.5 * std::pow((r - 97.0) / 1.5, 2)));
+      if (col >= 185 && col <= 187 && row >= 15 && row < 75) image.at(col, row) += 2.0f;
+    }
+  }
+  const auto metal = fct::MetalMaskDetector().detect(image, fct::ValidMask::allValid(200, 120), 1.0);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  EXPECT_FALSE(metal.value().mask.isValid(186, 40)) << "the bar is metal";
+  for (int col = 40; col <= 120; ++col) {
+    const int rimRow = static_cast<int>(std::lround(150.0 - std::sqrt(97.0 * 97.0 - std::pow(col - 100.0, 2))));
+    EXPECT_TRUE(metal.value().mask.isValid(col, rimRow)) << "rim at column " << col;
+  }
+}
+
 TEST(MetalMaskDetector, CleanImageLosesNoPixel) {
   const fct::ValidMask field = fct::ValidMask::allValid(160, 120);
   const auto metal = fct::MetalMaskDetector().detect(boneImage(0.0f), field);
@@ -69,7 +92,7 @@ TEST(MetalMaskDetector, RejectsSizeMismatchBadOptionsAndNaN) {
   const fct::FloatImage image = boneImage(0.0f);
   EXPECT_FALSE(fct::MetalMaskDetector().detect(image, fct::ValidMask::allValid(10, 10)).ok());
   fct::MetalMaskOptions badWindow;
-  badWindow.backgroundWindow_px = 1;
+  badWindow.narrowWindow_mm = 0.0;
   EXPECT_FALSE(fct::MetalMaskDetector(badWindow).detect(image, fct::ValidMask::allValid(160, 120)).ok());
   fct::MetalMaskOptions badExcess;
   badExcess.minExcess = 0.0;

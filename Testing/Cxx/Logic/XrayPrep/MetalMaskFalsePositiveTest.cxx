@@ -1,80 +1,194 @@
-// The metal mask on physically simulated views of the real CTs (continuous patient, 80 kVp, noise; 5 obliquities):
-// what it removes from metal-free views, and that it finds K-wires and screws that are not in the CT, printed for
-// each view; and the real shoulder fluoroscopy's K-wire. Needs ../shared/data; about 90 s (simulates 20 views).
-//
-// DISABLED: both fail today. Measured on 2026-12-01 (2-core Debian 12 development machine, shared;
-// `fluoroct_logic_tests --gtest_also_run_disabled_tests --gtest_filter='MetalMaskFalse*'`), default threshold 1.5:
-// metal-free pelvis views 0.00-0.22 %, metal-free head-phantom views 10.1-21.5 % (the skull's tangent rim is taken
-// for metal); with 2 K-wires and 2 screws 2.6-3.7 % (pelvis), 15.7-25.4 % (head); the real shoulder K-wire image
-// 0.00 % (its wire is not found). Enable them when the detector separates bone rims from metal.
+// The metal mask on physically simulated views (continuous patient, 80 kVp, 10,000 photons per pixel, PSF 0.7 px;
+// the 5 standard obliquities AP, lateral, oblique 45/30/60 on a 192x144 detector of 1.6 mm pixels) of the built-in
+// phantom and, when ../shared/data is there, of the head phantom and pelvis CTs: it removes less than 0.5 % of each
+// metal-free view, and covers most of the pixels of K-wires and screws that are not in the CT (the pixels whose
+// line integral the tools raise by more than 0.5 over the metal-free view with the same noise). The per-view table of
+// docs/evaluation.md comes from the disabled MetalMaskStudy test (both CTs, also at 0.8 mm pixels; about 5 min). The
+// real shoulder fluoroscopy's K-wire stays disabled: the contrast-processed image's wire stands only ~0.5 above its
+// surroundings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "Evaluation/StudyRunner.h"
 #include "IO/Volume/CtLoader.h"
 #include "Image/BoneSurface.h"
 #include "Simulation/FluoroscopySimulator.h"
+#include "Simulation/PhantomBuilder.h"
 #include "Simulation/StandardViews.h"
 #include "TestSupport.h"
 #include "TestXrayLoader.h"
+#include "XrayPrep/MetalMaskDetector.h"
 #include "XrayPrep/XrayPreparation.h"
 
 namespace {
 
-/// Largest fraction of valid pixels the metal mask (threshold minExcess) removes over the views of `ct` simulated with
-/// `kwires` K-wires and `screws` screws; prints each view's fraction.
-double largestMetalFraction(const fct::Volume& ct, int kwires, int screws, double minExcess) {
-  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(fct::BoneSurface::extract(ct).value());
-  fct::StandardViewOptions viewOptions;
-  viewOptions.count = 5;
-  viewOptions.cols = 192;
-  viewOptions.rows = 144;
-  viewOptions.pixelSpacing_mm = 1.6;
-  const std::vector<fct::ViewSpec> views = fct::StandardViews::build(Eigen::Vector3d::Zero(), viewOptions).value();
+/// What the metal mask does on one view.
+struct ViewMeasure {
+  std::string view;
+  double falsePositive = 0.0;  ///< fraction of the metal-free view's valid pixels masked
+  double coverage = 0.0;       ///< fraction of the tool pixels masked in the view with tools (1 without tools)
+  std::size_t toolPixels = 0;  ///< valid pixels the tools raise by more than 0.5
+};
+
+/// The level-0 line integrals and valid mask of a simulated view, prepared without the metal exclusion.
+struct Prepared {
+  fct::FloatImage lineIntegrals;
+  fct::ValidMask mask;
+};
+
+Prepared prepare(const fct::FloatImage& image, const fct::Camera& camera) {
+  fct::XrayImage xray;
+  xray.cols = image.cols;
+  xray.rows = image.rows;
+  xray.pixels = image.pixels;
+  xray.camera = camera;
+  fct::XrayPreparationOptions options;
+  options.excludeMetal = false;
+  auto prepared = fct::XrayPreparation(options).prepare(xray);
+  EXPECT_TRUE(prepared.ok()) << prepared.error();
+  if (!prepared) return {};
+  const fct::PyramidLevel& level = prepared.value().pyramid.level(0);
+  return {level.image, level.mask};
+}
+
+/// The images of the 5 standard views (noise seeds 1..5) of `ct` at `T_truth`, with or without 2 K-wires and 2 screws.
+std::vector<fct::FloatImage> renderViews(const fct::Volume& ct, const std::vector<fct::Camera>& cameras,
+                                         const Eigen::Isometry3d& T_truth, bool tools) {
   fct::FluoroscopyOptions options;
   options.photonsPerPixel = 10000.0;
   options.psfSigma_px = 0.7;
-  options.kwireCount = kwires;
-  options.screwCount = screws;
-  double largest = 0.0;
-  std::printf("  %d K-wires, %d screws, min excess %.1f:", kwires, screws, minExcess);
-  for (std::size_t v = 0; v < views.size(); ++v) {
-    auto image = fct::FluoroscopySimulator::render(ct, views[v].camera, T_truth, options, 1 + v);
-    EXPECT_TRUE(image.ok()) << image.error();
-    if (!image) return 1.0;
-    fct::XrayImage xray;
-    xray.cols = image.value().cols;
-    xray.rows = image.value().rows;
-    xray.pixels = image.value().pixels;
-    xray.camera = views[v].camera;
-    fct::XrayPreparationOptions prep;
-    prep.metal.minExcess = minExcess;
-    auto prepared = fct::XrayPreparation(prep).prepare(xray);
-    EXPECT_TRUE(prepared.ok()) << prepared.error();
-    if (!prepared) return 1.0;
-    std::printf(" %s %.2f %%", views[v].name.c_str(), 100.0 * prepared.value().metalFraction);
-    largest = std::max(largest, prepared.value().metalFraction);
-  }
-  std::printf("\n");
-  return largest;
+  options.kwireCount = tools ? 2 : 0;
+  options.screwCount = tools ? 2 : 0;
+  auto images = fct::FluoroscopySimulator::renderViews(ct, cameras, T_truth, options, 1);
+  EXPECT_TRUE(images.ok()) << images.error();
+  return images ? std::move(images).value() : std::vector<fct::FloatImage>{};
 }
+
+/// The metal mask's false positives on the metal-free views of `ct` and, with `coverage`, its coverage of 2 K-wires
+/// and 2 screws (tool pixels: those the tools raise by more than 0.5 over the metal-free view with the same noise
+/// seed), on the 5 standard views of a cols x rows detector of `spacing_mm` pixels; one table line printed per view.
+std::vector<ViewMeasure> measureViews(const fct::Volume& ct, const std::string& label, int cols, int rows,
+                                      double spacing_mm, bool coverage) {
+  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(fct::BoneSurface::extract(ct).value());
+  fct::StandardViewOptions viewOptions;
+  viewOptions.count = 5;
+  viewOptions.cols = cols;
+  viewOptions.rows = rows;
+  viewOptions.pixelSpacing_mm = spacing_mm;
+  const std::vector<fct::ViewSpec> views = fct::StandardViews::build(Eigen::Vector3d::Zero(), viewOptions).value();
+  std::vector<fct::Camera> cameras;
+  for (const fct::ViewSpec& view : views) cameras.push_back(view.camera);
+  const std::vector<fct::FloatImage> freeImages = renderViews(ct, cameras, T_truth, false);
+  const std::vector<fct::FloatImage> toolImages = coverage ? renderViews(ct, cameras, T_truth, true) : freeImages;
+  if (freeImages.size() != views.size() || toolImages.size() != views.size()) return {};
+  const fct::MetalMaskDetector detector;
+  std::vector<ViewMeasure> measures;
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    ViewMeasure measure{views[v].name, 0.0, 1.0, 0};
+    const Prepared metalFree = prepare(freeImages[v], cameras[v]);
+    const auto freeMask = detector.detect(metalFree.lineIntegrals, metalFree.mask, spacing_mm);
+    EXPECT_TRUE(freeMask.ok()) << freeMask.error();
+    if (!freeMask) return measures;
+    measure.falsePositive =
+        static_cast<double>(freeMask.value().metalPixelCount) / static_cast<double>(metalFree.mask.validCount());
+    if (coverage) {
+      const Prepared withTools = prepare(toolImages[v], cameras[v]);
+      const auto toolMask = detector.detect(withTools.lineIntegrals, withTools.mask, spacing_mm);
+      EXPECT_TRUE(toolMask.ok()) << toolMask.error();
+      if (!toolMask) return measures;
+      std::size_t covered = 0;
+      for (std::size_t i = 0; i < toolImages[v].pixels.size(); ++i) {
+        const double raise = std::log(std::max(freeImages[v].pixels[i], 1e-6f) /
+                                      std::max(toolImages[v].pixels[i], 1e-6f));
+        if (!withTools.mask.valid[i] || raise <= 0.5) continue;
+        ++measure.toolPixels;
+        if (!toolMask.value().mask.valid[i]) ++covered;
+      }
+      measure.coverage =
+          static_cast<double>(covered) / static_cast<double>(std::max<std::size_t>(1, measure.toolPixels));
+    }
+    const std::string covers =
+        coverage ? fmt::format("{:.1f} % of {} px", 100.0 * measure.coverage, measure.toolPixels) : "-";
+    std::printf("| %s | %s | %dx%d px of %.1f mm | %.2f %% | %s |\n", label.c_str(), measure.view.c_str(), cols, rows,
+                spacing_mm, 100.0 * measure.falsePositive, covers.c_str());
+    measures.push_back(measure);
+  }
+  return measures;
+}
+
+/// Loads a CT of the shared data folder (the caller has checked it exists).
+fct::Volume loadCt(const std::string& relative) {
+  auto ct = fct::CtLoader::load(fct::test::dataDir() / relative);
+  EXPECT_TRUE(ct.ok()) << ct.error();
+  return ct ? std::move(ct).value() : fct::Volume{};
+}
+
+/// Every view loses less than 0.5 % to false positives.
+void expectFewFalsePositives(const std::vector<ViewMeasure>& measures) {
+  EXPECT_EQ(measures.size(), 5u);
+  for (const ViewMeasure& m : measures) EXPECT_LT(m.falsePositive, 0.005) << m.view;
+}
+
+/// Every view's tools are masked over at least `minCoverage` of their pixels.
+void expectCoverage(const std::vector<ViewMeasure>& measures, double minCoverage) {
+  EXPECT_EQ(measures.size(), 5u);
+  for (const ViewMeasure& m : measures) {
+    EXPECT_GT(m.toolPixels, 100u) << m.view;
+    EXPECT_GE(m.coverage, minCoverage) << m.view;
+  }
+}
+
+constexpr const char* kHead = "ct/head_phantom_philips_bone";
+constexpr const char* kPelvis = "ct/pelvis_totalseg.nii.gz";
 
 }  // namespace
 
-TEST(MetalMaskFalsePositives, DISABLED_MeasuredOnMetalFreeAndMetalViewsOfBothCts) {
-  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
-  FCT_REQUIRE_DATA("ct/head_phantom_philips_bone");
-  const double minExcess = fct::MetalMaskOptions{}.minExcess;
-  for (const std::string name : {"ct/pelvis_totalseg.nii.gz", "ct/head_phantom_philips_bone"}) {
-    SCOPED_TRACE(name);
-    auto ct = fct::CtLoader::load(fct::test::dataDir() / name);
-    ASSERT_TRUE(ct.ok()) << ct.error();
-    std::printf("%s\n", name.c_str());
-    EXPECT_LT(largestMetalFraction(ct.value(), 0, 0, minExcess), 0.005);
-    EXPECT_GT(largestMetalFraction(ct.value(), 2, 2, minExcess), 0.001);
+TEST(MetalMaskFalsePositives, PhantomMetalFreeViewsLoseUnderHalfAPercent) {
+  expectFewFalsePositives(measureViews(fct::PhantomBuilder::build({}).value(), "phantom", 192, 144, 1.6, false));
+}
+
+TEST(MetalMaskFalsePositives, HeadPhantomMetalFreeViewsLoseUnderHalfAPercent) {
+  FCT_REQUIRE_DATA(kHead);
+  expectFewFalsePositives(measureViews(loadCt(kHead), "head", 192, 144, 1.6, false));
+}
+
+TEST(MetalMaskFalsePositives, PelvisMetalFreeViewsLoseUnderHalfAPercent) {
+  FCT_REQUIRE_DATA(kPelvis);
+  expectFewFalsePositives(measureViews(loadCt(kPelvis), "pelvis", 192, 144, 1.6, false));
+}
+
+TEST(MetalMaskCoverage, PhantomKWiresAndScrewsAreMasked) {
+  expectCoverage(measureViews(fct::PhantomBuilder::build({}).value(), "phantom", 192, 144, 1.6, true), 0.6);
+}
+
+TEST(MetalMaskCoverage, HeadPhantomKWiresAndScrewsAreMasked) {
+  FCT_REQUIRE_DATA(kHead);
+  expectCoverage(measureViews(loadCt(kHead), "head", 192, 144, 1.6, true), 0.8);
+}
+
+TEST(MetalMaskCoverage, PelvisKWiresAndScrewsAreMasked) {
+  // At 1.6 mm pixels a 2 mm K-wire over the pelvis stands less than 1.0 above its surroundings in some views: the
+  // screws and the wires' stronger parts are found.
+  FCT_REQUIRE_DATA(kPelvis);
+  expectCoverage(measureViews(loadCt(kPelvis), "pelvis", 192, 144, 1.6, true), 0.55);
+}
+
+TEST(MetalMaskStudy, DISABLED_TablePerViewOnBothCtsAtTwoPixelSizes) {
+  FCT_REQUIRE_DATA(kHead);
+  FCT_REQUIRE_DATA(kPelvis);
+  std::printf("| CT | view | detector | metal-free view masked | tool pixels masked |\n|---|---|---|---|---|\n");
+  for (const char* name : {kHead, kPelvis}) {
+    const fct::Volume ct = loadCt(name);
+    const std::string label = name == kHead ? "head phantom" : "pelvis";
+    expectFewFalsePositives(measureViews(ct, label, 192, 144, 1.6, true));
+    expectFewFalsePositives(measureViews(ct, label, 384, 288, 0.8, true));
   }
 }
 
