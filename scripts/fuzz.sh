@@ -132,11 +132,7 @@ for t in "${targets[@]}"; do
   [[ $t == session ]] && program="$fuzz_build/bin/fluoroct_fuzz_studio"
   mkdir -p "$work/corpus/$t" "$work/crashes/$t" "$seeds/$t"
   log="$work/$t.log"
-  # DCMTK allocates an element's declared length (32 bits: below 4 GiB) while it parses a file, before it finds that
-  # the file is shorter (docs/robustness.md "Fuzzing"); the DICOM targets get a malloc limit above that.
-  malloc_mb=2048
-  [[ $t == dicom_* || $t == xray_dicom ]] && malloc_mb=4200
-  limits=(-timeout=10 -rss_limit_mb=6144 -malloc_limit_mb="$malloc_mb" -print_final_stats=1 -runs="$runs")
+  limits=(-timeout=10 -rss_limit_mb=6144 -malloc_limit_mb=2048 -print_final_stats=1 -runs="$runs")
   ((seconds > 0)) && limits+=(-max_total_time="$seconds")
   echo "fuzz: $t for ${seconds}s (runs $runs) ..."
   set +e
