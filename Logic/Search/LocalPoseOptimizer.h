@@ -21,12 +21,12 @@ enum class LocalSearchMethod {
 
 /// Settings of a local search, in scaled units (about 1 mm of bone-surface motion each).
 struct LocalSearchOptions {
-  LocalSearchMethod method = LocalSearchMethod::Simplex;  ///< which search create() makes
-  double initialStep = 2.0;      ///< first step along each axis (simplex edge, BOBYQA trust radius), scaled units (> tolerance)
+  double initialStep = 2.0;      ///< first step per axis (simplex edge, BOBYQA trust radius), scaled units (> tolerance)
   double tolerance = 0.01;       ///< stop once the search moves less than this along every axis, scaled units
   int maxEvaluations = 2000;     ///< cap on objective evaluations per call (> 0)
   int restarts = 1;              ///< fresh searches started from the converged best (>= 0)
   StallOptions stall;            ///< also stop (without restarting) once the search stops improving (off by default)
+  LocalSearchMethod method = LocalSearchMethod::Simplex;  ///< which search create() makes
 };
 
 /// A local search over the 6 pose parameters.
