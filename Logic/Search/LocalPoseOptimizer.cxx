@@ -18,10 +18,6 @@ std::unique_ptr<LocalPoseOptimizer> LocalPoseOptimizer::create(const LocalSearch
   return std::make_unique<NelderMeadOptimizer>(options);
 }
 
-std::string_view LocalPoseOptimizer::methodName(LocalSearchMethod method) {
-  return method == LocalSearchMethod::Bobyqa ? "bobyqa" : "simplex";
-}
-
 Status LocalPoseOptimizer::validateOptions() const {
   const auto& o = m_options;
   if (!std::isfinite(o.tolerance) || o.tolerance <= 0.0) {

@@ -4,7 +4,6 @@
 // one the options name.
 
 #include <memory>
-#include <string_view>
 #include <utility>
 
 #include "Search/ObjectiveEvaluator.h"
@@ -37,8 +36,6 @@ class LocalPoseOptimizer : public PoseOptimizer {
 
   /// The search the options' method names.
   static std::unique_ptr<LocalPoseOptimizer> create(const LocalSearchOptions& options);
-  /// Lowercase name of a method ("simplex", "bobyqa").
-  static std::string_view methodName(LocalSearchMethod method);
 
   /// Runs one local search from `start_scaled` inside another strategy's evaluator (which counts, caps and cancels);
   /// returns the best scaled point and its value, and sets `converged` if the tolerance was reached.
