@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -14,7 +15,7 @@
 #include "Registration/RegistrationObjective.h"
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
-#include "Search/NelderMeadOptimizer.h"
+#include "Search/LocalPoseOptimizer.h"
 
 
 namespace fct {
@@ -26,6 +27,9 @@ using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
+
+/// Process CPU time (all threads) since `start` (a std::clock() reading), seconds.
+double cpuSecondsSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
 
 /// The stage's search strategy with the stage's evaluation cap applied.
 std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage) {
@@ -43,9 +47,9 @@ std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage) {
     }
     case SearchStrategy::Local: break;
   }
-  NelderMeadOptions o = stage.simplex;
+  LocalSearchOptions o = stage.simplex;
   o.maxEvaluations = std::min(o.maxEvaluations, stage.maxEvaluations);
-  return std::make_unique<NelderMeadOptimizer>(o);
+  return LocalPoseOptimizer::create(o);
 }
 
 /// The start pose as a pose vector (deg about the bone centre, mm). Fails on an empty schedule, a non-rigid
@@ -168,6 +172,7 @@ Status applySearchOutcome(const Result<OptimizationResult>& found, const Progres
 Result<StageReport> runStage(const StageContext& context, int stageIndex, const RegistrationStage& stage,
                              RegistrationObjective& objective, long drrsBefore, PoseVector& current) {
   const auto stageStart = Clock::now();
+  const std::clock_t stageCpuStart = std::clock();
   RegistrationCase& registrationCase = context.registrationCase;
   auto startValue = objective.similarity(registrationCase.poseTransform(current));
   if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
@@ -200,6 +205,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   report.drrs = objective.drrCount();
   report.fallbackRays = objective.fallbackRayCount();
   report.seconds = secondsSince(stageStart);
+  report.cpuSeconds = cpuSecondsSince(stageCpuStart);
   report.T_world_from_ct = registrationCase.poseTransform(current);
   return report;
 }

@@ -51,6 +51,7 @@ struct StageReport {
   int level = 0;                   ///< pyramid level: 0 = full resolution
   SearchStrategy search = SearchStrategy::Local;
   double seconds = 0.0;
+  double cpuSeconds = 0.0;         ///< process CPU time (every thread) during the stage: less load-sensitive than seconds
   long drrs = 0;                   ///< DRRs rendered in the stage (evaluations x views)
   long fallbackRays = 0;           ///< Transgraph rays outside their table, integrated exactly (0 for other methods)
   int evaluations = 0;

@@ -24,6 +24,8 @@ constexpr NameTable<SimilarityMetric, 3> kMetrics{
     {{"ncc", SimilarityMetric::Ncc}, {"vlnc", SimilarityMetric::Vlnc}, {"gc", SimilarityMetric::GradientCorrelation}}};
 constexpr NameTable<SearchStrategy, 3> kSearches{
     {{"genetic", SearchStrategy::Genetic}, {"cmaes", SearchStrategy::CmaEs}, {"local", SearchStrategy::Local}}};
+constexpr NameTable<LocalSearchMethod, 2> kLocalMethods{
+    {{"simplex", LocalSearchMethod::Simplex}, {"bobyqa", LocalSearchMethod::Bobyqa}}};
 constexpr NameTable<PixelSetKind, 2> kPixelSets{
     {{"whole", PixelSetKind::WholeImage}, {"rois", PixelSetKind::Rois}}};
 
@@ -35,12 +37,15 @@ void optionalInteger(JsonReader& reader, std::string_view key, int minimum, int&
   if (reader.has(key)) value = reader.integer(key, minimum);
 }
 
-void readSimplex(const nlohmann::json& object, const std::string& where, JsonReader& parent, NelderMeadOptions& o) {
+void readSimplex(const nlohmann::json& object, const std::string& where, JsonReader& parent, LocalSearchOptions& o) {
   JsonReader reader(object, where);
+  if (reader.has("method")) o.method = parseName(reader, "method", kLocalMethods);
   optionalNumber(reader, "initial_step", o.initialStep);
   optionalNumber(reader, "tolerance", o.tolerance);
   optionalInteger(reader, "max_evaluations", 1, o.maxEvaluations);
   optionalInteger(reader, "restarts", 0, o.restarts);
+  optionalInteger(reader, "stall_window", 0, o.stall.window);
+  optionalNumber(reader, "stall_improvement", o.stall.relativeImprovement);
   parent.adoptError(reader);
 }
 
@@ -111,7 +116,7 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
 
   stage.genetic.maxEvaluations = stage.maxEvaluations;
   stage.genetic.local = stage.simplex;
-  for (const Status& status : {NelderMeadOptimizer(stage.simplex).validateOptions(),
+  for (const Status& status : {LocalPoseOptimizer::create(stage.simplex)->validateOptions(),
                                GeneticSearchOptimizer(stage.genetic).validateOptions(),
                                CmaEsOptimizer(stage.cmaes).validateOptions()}) {
     if (!status) return fail(fmt::format("{}: {}", where, status.error()));
@@ -219,6 +224,13 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
                          {"tolerance", s.simplex.tolerance},
                          {"max_evaluations", s.simplex.maxEvaluations},
                          {"restarts", s.simplex.restarts}};
+    if (s.simplex.method != LocalSearchMethod::Simplex) {
+      search["simplex"]["method"] = nameOf(s.simplex.method, kLocalMethods);
+    }
+    if (s.simplex.stall.window > 0) {
+      search["simplex"]["stall_window"] = s.simplex.stall.window;
+      search["simplex"]["stall_improvement"] = s.simplex.stall.relativeImprovement;
+    }
     search["cmaes"] = {{"sigma", s.cmaes.initialSigma},
                        {"tolerance", s.cmaes.tolerance},
                        {"population", s.cmaes.populationSize},

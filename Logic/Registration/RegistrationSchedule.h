@@ -16,7 +16,7 @@
 #include "Base/Result.h"
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
-#include "Search/NelderMeadOptimizer.h"
+#include "Search/LocalPoseOptimizer.h"
 
 namespace fct {
 
@@ -54,7 +54,7 @@ struct RegistrationStage {
   int maxEvaluations = 1000;       ///< cap on DRR sets (one per view) of the stage's search
   GeneticSearchOptions genetic;    ///< used by Genetic (its `local` is the simplex below)
   CmaEsOptions cmaes;              ///< used by CmaEs
-  NelderMeadOptions simplex;       ///< the local search: alone (Local) or inside each genetic guess
+  LocalSearchOptions simplex;      ///< the local search (simplex or BOBYQA): alone (Local) or inside each genetic guess
 };
 
 /// Ablation switches: each one true turns a technique of the paper off (defaults: everything on). The five techniques

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "Base/SeededRandom.h"
 #include "Geometry/RigidPose.h"
@@ -53,7 +54,7 @@ Status GeneticSearchOptimizer::validateOptions() const {
   if (o.maxEvaluations <= 0) {
     return fail(fmt::format("genetic search maximum evaluations must be positive, got {}", o.maxEvaluations));
   }
-  return NelderMeadOptimizer(o.local).validateOptions();
+  return LocalPoseOptimizer::create(o.local)->validateOptions();
 }
 
 OptimizationResult GeneticSearchOptimizer::search(const PoseObjective& objective, const PoseVector& start,
@@ -61,7 +62,7 @@ OptimizationResult GeneticSearchOptimizer::search(const PoseObjective& objective
   const auto& o = m_options;
   ObjectiveEvaluator evaluator(objective, start, scales, o.maxEvaluations, monitor);
   SeededRandom random(o.seed);
-  const NelderMeadOptimizer local(o.local);
+  const std::unique_ptr<LocalPoseOptimizer> local = LocalPoseOptimizer::create(o.local);
 
   int planned = o.randomGuesses + 1;
   for (int children = o.randomGuesses / 2, g = 1; children > 0 && g <= o.maxGenerations; children /= 2, ++g) {
@@ -70,7 +71,7 @@ OptimizationResult GeneticSearchOptimizer::search(const PoseObjective& objective
   int done = 0;
   int generation = 0;
   auto refine = [&](const PoseVector& params) {
-    const auto [best_scaled, value] = local.searchScaled(evaluator, evaluator.toScaled(params), nullptr);
+    const auto [best_scaled, value] = local->searchScaled(evaluator, evaluator.toScaled(params), nullptr);
     ++done;
     monitor.report(name(), static_cast<double>(done) / planned,
                    fmt::format("generation {}, local search {}/{}, {} evaluations, best value {:.6g}", generation, done,

@@ -1,6 +1,6 @@
 #pragma once
 // GeneticSearchOptimizer: the paper's global search (Knaan & Joskowicz 2003). From the start pose plus n random
-// poses, each guess is refined by the downhill simplex; guesses whose value is more than `dropThreshold` above the
+// poses, each guess is refined by the local search; guesses whose value is more than `dropThreshold` above the
 // best are dropped; n/2 new guesses are made as random pairwise combinations of the survivors on the pose manifold
 // and refined; the survivors and the new guesses form the next generation. The number of new guesses halves each
 // generation (n/2, n/4, ..., 1), and the search ends when one guess survives, no new guess is due, or a limit is hit.
@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "Search/NelderMeadOptimizer.h"
+#include "Search/LocalPoseOptimizer.h"
 #include "Search/PoseOptimizer.h"
 
 namespace fct {
@@ -23,10 +23,10 @@ struct GeneticSearchOptions {
   int maxGenerations = 10;            ///< generations after the initial one (>= 0)
   int maxEvaluations = 20000;         ///< cap on objective evaluations of the whole search (> 0)
   std::uint32_t seed = 1;             ///< random seed; the same seed gives the same result
-  NelderMeadOptions local;            ///< the local search run on every guess
+  LocalSearchOptions local;           ///< the local search run on every guess (simplex or BOBYQA)
 };
 
-/// Genetic search with a downhill-simplex local search.
+/// Genetic search with a local search (downhill simplex or BOBYQA) on every guess.
 class GeneticSearchOptimizer : public PoseOptimizer {
  public:
   /// A search with the given options (checked when minimize() is called).

@@ -1,7 +1,5 @@
 #include "Search/NelderMeadOptimizer.h"
 
-#include <fmt/core.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,7 +10,6 @@ namespace fct {
 namespace {
 
 constexpr int kN = 6;
-constexpr int kReportInterval = 25;  // evaluations between progress reports of a stand-alone run
 // Gao & Han (2012) adaptive coefficients for dimension n.
 constexpr double kReflect = 1.0;
 constexpr double kExpand = 1.0 + 2.0 / kN;
@@ -44,32 +41,23 @@ struct Simplex {
 
 }  // namespace
 
-Status NelderMeadOptimizer::validateOptions() const {
-  const auto& o = m_options;
-  if (!std::isfinite(o.tolerance) || o.tolerance <= 0.0) {
-    return fail(fmt::format("Nelder–Mead tolerance must be positive (scaled units), got {}", o.tolerance));
-  }
-  if (!std::isfinite(o.initialStep) || o.initialStep <= o.tolerance) {
-    return fail(fmt::format("Nelder–Mead initial step {} must be larger than the tolerance {} (scaled units)",
-                            o.initialStep, o.tolerance));
-  }
-  if (o.maxEvaluations <= 0) {
-    return fail(fmt::format("Nelder–Mead maximum evaluations must be positive, got {}", o.maxEvaluations));
-  }
-  if (o.restarts < 0) return fail(fmt::format("Nelder–Mead restarts must be 0 or more, got {}", o.restarts));
-  return Ok{};
-}
-
 std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluator& evaluator,
                                                                 const PoseVector& start_scaled,
                                                                 bool* converged) const {
   const int firstEvaluation = evaluator.evaluations();
+  StallDetector stall(m_options.stall);
   auto outOfBudget = [&] {
-    return evaluator.stopped() || evaluator.evaluations() - firstEvaluation >= m_options.maxEvaluations;
+    return evaluator.stopped() || evaluator.evaluations() - firstEvaluation >= m_options.maxEvaluations ||
+           stall.stalled();
+  };
+  auto evaluate = [&](const PoseVector& y_scaled) {
+    const double value = evaluator.atScaled(y_scaled);
+    stall.add(value);
+    return value;
   };
   bool reachedTolerance = false;
   PoseVector best = start_scaled;
-  double bestValue = evaluator.atScaled(best);
+  double bestValue = evaluate(best);
 
   for (int run = 0; run <= m_options.restarts && !outOfBudget(); ++run) {
     Simplex s;
@@ -78,7 +66,7 @@ std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluat
     for (int i = 0; i < kN; ++i) {
       s.vertex[i + 1] = best;
       s.vertex[i + 1][i] += m_options.initialStep;
-      s.value[i + 1] = evaluator.atScaled(s.vertex[i + 1]);
+      s.value[i + 1] = evaluate(s.vertex[i + 1]);
     }
     reachedTolerance = false;
     while (!outOfBudget()) {
@@ -92,10 +80,10 @@ std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluat
       centroid /= kN;
       const PoseVector& worst = s.vertex[kN];
       const PoseVector reflected = centroid + kReflect * (centroid - worst);
-      const double fr = evaluator.atScaled(reflected);
+      const double fr = evaluate(reflected);
       if (fr < s.value[0]) {
         const PoseVector expanded = centroid + kExpand * (reflected - centroid);
-        const double fe = evaluator.atScaled(expanded);
+        const double fe = evaluate(expanded);
         if (fe < fr) {
           s.vertex[kN] = expanded;
           s.value[kN] = fe;
@@ -114,7 +102,7 @@ std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluat
       const PoseVector contracted =
           outside ? PoseVector(centroid + kContract * (reflected - centroid))
                   : PoseVector(centroid + kContract * (worst - centroid));
-      const double fc = evaluator.atScaled(contracted);
+      const double fc = evaluate(contracted);
       if (outside ? fc <= fr : fc < s.value[kN]) {
         s.vertex[kN] = contracted;
         s.value[kN] = fc;
@@ -122,7 +110,7 @@ std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluat
       }
       for (int i = 1; i <= kN; ++i) {
         s.vertex[i] = s.vertex[0] + kShrink * (s.vertex[i] - s.vertex[0]);
-        s.value[i] = evaluator.atScaled(s.vertex[i]);
+        s.value[i] = evaluate(s.vertex[i]);
       }
     }
     s.sort();
@@ -136,19 +124,6 @@ std::pair<PoseVector, double> NelderMeadOptimizer::searchScaled(ObjectiveEvaluat
   }
   if (converged) *converged = reachedTolerance;
   return {best, bestValue};
-}
-
-OptimizationResult NelderMeadOptimizer::search(const PoseObjective& objective, const PoseVector& start,
-                                               const PoseVector& scales, const ProgressMonitor& monitor) const {
-  ObjectiveEvaluator evaluator(objective, start, scales, m_options.maxEvaluations, monitor);
-  evaluator.reportEvery(kReportInterval, name());
-  bool converged = false;
-  (void)searchScaled(evaluator, evaluator.toScaled(start), &converged);
-  OptimizationResult result = evaluator.result(converged);
-  monitor.report(name(), 1.0,
-                 fmt::format("{} evaluations, best value {:.6g}{}", result.evaluations, result.value,
-                             result.cancelled ? " (cancelled)" : ""));
-  return result;
 }
 
 }  // namespace fct

@@ -47,7 +47,10 @@ fct::RegistrationSchedule baselineSchedule() {
   stage.pixels.kind = fct::PixelSetKind::WholeImage;
   stage.search = fct::SearchStrategy::Local;
   stage.maxEvaluations = 3000;
-  stage.simplex = {3.0, 0.02, 3000, 1};
+  stage.simplex.initialStep = 3.0;
+  stage.simplex.tolerance = 0.02;
+  stage.simplex.maxEvaluations = 3000;
+  stage.simplex.restarts = 1;
   schedule.stages.push_back(stage);
   return schedule;
 }

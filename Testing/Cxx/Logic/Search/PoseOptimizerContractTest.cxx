@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "OptimizerTestFunctions.h"
+#include "Search/BobyqaOptimizer.h"
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
 #include "Search/NelderMeadOptimizer.h"
@@ -36,6 +37,18 @@ struct OptimizerTraits<fct::NelderMeadOptimizer> {
     fct::NelderMeadOptions options;
     options.tolerance = 0.0;
     return fct::NelderMeadOptimizer(options);
+  }
+};
+
+template <>
+struct OptimizerTraits<fct::BobyqaOptimizer> {
+  static constexpr bool kSeeded = false;  // deterministic: BOBYQA draws no random numbers
+  static fct::BobyqaOptimizer make(std::uint32_t /*seed*/) { return fct::BobyqaOptimizer(); }
+  static constexpr const char* kBadOption = "initial step";
+  static fct::BobyqaOptimizer withBadOption() {
+    fct::LocalSearchOptions options;
+    options.initialStep = options.tolerance;
+    return fct::BobyqaOptimizer(options);
   }
 };
 
@@ -79,7 +92,8 @@ class PoseOptimizerContract : public ::testing::Test {
   const PoseVector target = t::targetPose();
 };
 
-using ContractOptimizers = ::testing::Types<fct::NelderMeadOptimizer, fct::GeneticSearchOptimizer, fct::CmaEsOptimizer>;
+using ContractOptimizers = ::testing::Types<fct::NelderMeadOptimizer, fct::BobyqaOptimizer, fct::GeneticSearchOptimizer,
+                                           fct::CmaEsOptimizer>;
 TYPED_TEST_SUITE(PoseOptimizerContract, ContractOptimizers);
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
