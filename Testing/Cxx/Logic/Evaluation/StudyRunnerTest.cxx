@@ -24,9 +24,10 @@ std::vector<fct::Camera> standardCameras() {
   std::vector<fct::Camera> cameras;
   fct::StandardViewOptions options;
   options.count = 3;
-  for (const fct::ViewSpec& view : fct::StandardViews::build(Eigen::Vector3d::Zero(), options).value()) {
-    cameras.push_back(view.camera);
-  }
+  const auto views = fct::StandardViews::build(Eigen::Vector3d::Zero(), options);
+  EXPECT_TRUE(views.ok()) << views.error();
+  if (!views) return cameras;
+  for (const fct::ViewSpec& view : views.value()) cameras.push_back(view.camera);
   return cameras;
 }
 
