@@ -119,7 +119,7 @@ Status CineTracker::runSchedule(const RegistrationSchedule& schedule, const Eige
   options.schedule = schedule;
   options.checkOverlap = false;  // the start is a tracked pose; the check would cost a whole-level DRR per frame
   auto result = Registration::run(*m_case, T_start, options, {}, cancel);
-  if (!result) return fail(fmt::format("frame {}: {}", frame.index, result.error()));
+  if (!result) return fail(result.error());
   const RegistrationResult& r = result.value();
   frame.T_world_from_ct = r.T_world_from_ct;
   frame.drrs += r.totalDrrs;
@@ -172,27 +172,36 @@ Result<TrackedFrame> CineTracker::trackNext(const std::vector<XrayImage>& frameI
     return fail(fmt::format("frame {}: {} images given for {} views; give one image per view", m_nextIndex,
                             frameImages.size(), m_case->viewCount()));
   }
+  for (std::size_t v = 0; v < frameImages.size(); ++v) {
+    const CameraIntrinsics& in = m_case->camera(v).intrinsics();
+    if (frameImages[v].cols != in.cols || frameImages[v].rows != in.rows) {
+      return fail(fmt::format("frame {}, view '{}': the image is {}x{} pixels but the view's detector is {}x{}",
+                              m_nextIndex, m_case->viewName(v), frameImages[v].cols, frameImages[v].rows, in.cols,
+                              in.rows));
+    }
+  }
   const auto start = Clock::now();
   const std::clock_t cpuStart = std::clock();
   TrackedFrame frame;
   frame.index = m_nextIndex;
-  for (std::size_t v = 0; v < frameImages.size(); ++v) {
-    if (Status swapped = m_case->replaceXray(v, frameImages[v]); !swapped) {
-      return fail(fmt::format("frame {}: {}", frame.index, swapped.error()));
-    }
-  }
-  frame.swapSeconds = secondsSince(start);
   frame.runningLevel = m_runningLevel;
   const Eigen::Vector3d& centre = m_case->rotationCentre_ct_mm();
-  frame.T_predicted_world_from_ct =
+  frame.T_predicted_world_from_ct = frame.T_world_from_ct =
       m_options.constantVelocity ? predictedPose(*m_T_previous, m_T_beforePrevious, centre) : *m_T_previous;
+  Status usable = Ok{};
+  for (std::size_t v = 0; v < frameImages.size() && usable; ++v) usable = m_case->replaceXray(v, frameImages[v]);
+  frame.swapSeconds = secondsSince(start);
 
-  if (Status run = runSchedule(m_frameSchedule, frame.T_predicted_world_from_ct, cancel, frame); !run) return fail(run.error());
-  if (!frame.cancelled && !withinBounds(frame)) {
-    if (Status run = runSchedule(m_recoverySchedule, frame.T_predicted_world_from_ct, cancel, frame); !run) {
-      return fail(run.error());
-    }
-    frame.status = withinBounds(frame) ? TrackedFrameStatus::Recovered : TrackedFrameStatus::Lost;
+  if (usable) usable = runSchedule(m_frameSchedule, frame.T_predicted_world_from_ct, cancel, frame);
+  if (usable && !frame.cancelled && !withinBounds(frame)) {
+    usable = runSchedule(m_recoverySchedule, frame.T_predicted_world_from_ct, cancel, frame);
+    if (usable) frame.status = withinBounds(frame) ? TrackedFrameStatus::Recovered : TrackedFrameStatus::Lost;
+  }
+  if (!usable) {
+    frame.status = TrackedFrameStatus::Lost;
+    frame.note = fmt::format("frame {}: {}", frame.index, usable.error());
+    frame.T_world_from_ct = frame.T_predicted_world_from_ct;
+    frame.similarity = 0.0;
   }
   if (!frame.cancelled) {
     if (frame.status == TrackedFrameStatus::Lost) {

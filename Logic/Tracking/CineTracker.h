@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "Base/Result.h"
@@ -46,6 +47,9 @@ struct TrackedFrame {
   long fallbackRays = 0;     ///< Transgraph rays outside their tables, integrated exactly
   TrackedFrameStatus status = TrackedFrameStatus::Tracked;
   bool cancelled = false;    ///< the cancel flag stopped the frame; the pose is the best so far
+  /// Why a Lost frame could not be searched at all (its X-ray or its ROIs unusable, e.g. a blank frame); the pose is
+  /// then the prediction. Empty otherwise.
+  std::string note;
 };
 
 /// Settings of the tracker. Scaled units as LocalSearchOptions (about 1 mm of bone-surface motion).
@@ -81,8 +85,9 @@ class CineTracker {
   /// similarity level. Fails as Registration::run; a cancelled run is a success with `cancelled` set.
   Result<TrackedFrame> trackFirst(const Eigen::Isometry3d& T_initial, const std::atomic<bool>* cancel = nullptr);
   /// Tracks the next frame: one image per view, in the case's view order and of each view's detector size. Fails
-  /// before trackFirst, on a wrong image count or size, an X-ray the preparation rejects (naming the view), or a
-  /// rendering error. A cancelled frame is a success with `cancelled` set.
+  /// before trackFirst or on a wrong image count or size. A frame whose X-ray the preparation rejects or whose search
+  /// cannot run (no ROI, e.g. a blank or garbled frame) is a success: `Lost`, with the reason in `note`. A cancelled
+  /// frame is a success with `cancelled` set.
   Result<TrackedFrame> trackNext(const std::vector<XrayImage>& frameImages, const std::atomic<bool>* cancel = nullptr);
 
   /// The frame stage (VLNC on ROIs at the tracker's level, local BOBYQA), as run on every frame after the first.
@@ -94,7 +99,8 @@ class CineTracker {
 
  private:
   CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options, RegistrationStage frameStage);
-  /// Runs `schedule` from T_start and folds its result into `frame` (pose, similarity, DRRs, cancelled).
+  /// Runs `schedule` from T_start and folds its result into `frame` (pose, similarity, DRRs, cancelled); fails with
+  /// Registration's message.
   Status runSchedule(const RegistrationSchedule& schedule, const Eigen::Isometry3d& T_start,
                      const std::atomic<bool>* cancel, TrackedFrame& frame);
   /// True when `frame` passes the lost-track rule against the running level and its prediction.

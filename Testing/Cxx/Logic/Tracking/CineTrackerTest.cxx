@@ -1,0 +1,160 @@
+// CineTracker: follows a short simulated sequence (physical simulator, moving phantom bone) frame by frame, flags a
+// dropout frame and recovers after it; RegistrationCase::replaceXray (the frame swap); bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "Registration/RegistrationCase.h"
+#include "Simulation/PhantomBuilder.h"
+#include "Tracking/CineTracker.h"
+#include "TrackingTestSequence.h"
+
+namespace {
+
+fct::Volume smallPhantom() {
+  fct::PhantomOptions options;
+  options.dims = Eigen::Vector3i(80, 80, 60);
+  options.spacing_mm = 2.0;
+  return fct::PhantomBuilder::build(options).value();
+}
+
+/// A biplane 128^2 sequence of the phantom and a case prepared on its frame 0.
+struct Tracked {
+  fct::Volume ct;
+  fct::test::SimulatedSequence sequence;
+  fct::RegistrationCase registrationCase;
+};
+
+Tracked prepare(int frames, int viewCount = 2) {
+  fct::Volume ct = smallPhantom();
+  fct::test::SequenceOptions options;
+  options.frames = frames;
+  options.viewCount = viewCount;
+  auto sequence = fct::test::simulateSequence(ct, options);
+  EXPECT_TRUE(sequence.ok()) << sequence.error();
+  auto registrationCase = fct::RegistrationCase::create(ct, sequence.value().views);
+  EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
+  return Tracked{std::move(ct), std::move(sequence).value(), std::move(registrationCase).value()};
+}
+
+fct::CineTrackerOptions fastTracker() {
+  fct::CineTrackerOptions options;
+  options.firstFrame.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  options.level = 0;  // the 128^2 test detector: its 1:4 level has 4.8 mm pixels
+  return options;
+}
+
+double errorOf(const Tracked& t, const fct::TrackedFrame& frame) {
+  return t.registrationCase.bone()->meanDistance_mm(frame.T_world_from_ct, t.sequence.T_truth[frame.index]);
+}
+
+/// Frame 0 starts 3 mm (mean surface distance) off the truth.
+Eigen::Isometry3d firstStart(const Tracked& t) {
+  Eigen::Isometry3d T = t.sequence.T_truth[0];
+  T.translation() += Eigen::Vector3d(2.0, -1.5, 1.5);
+  return T;
+}
+
+}  // namespace
+
+TEST(CineTracker, FollowsSmoothlyMovingBoneWithinAMillimetrePerFrame) {
+  Tracked t = prepare(6);
+  auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
+  ASSERT_TRUE(tracker.ok()) << tracker.error();
+  auto first = tracker.value().trackFirst(firstStart(t));
+  ASSERT_TRUE(first.ok()) << first.error();
+  EXPECT_LT(errorOf(t, first.value()), 1.0);  // the fast preset on a 128^2 biplane case
+  for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
+    auto frame = tracker.value().trackNext(t.sequence.frames[f]);
+    ASSERT_TRUE(frame.ok()) << frame.error();
+    EXPECT_EQ(frame.value().index, static_cast<int>(f));
+    EXPECT_EQ(frame.value().status, fct::TrackedFrameStatus::Tracked) << "frame " << f;
+    EXPECT_LT(errorOf(t, frame.value()), 1.0) << "frame " << f;
+    EXPECT_GT(frame.value().drrs, 0);
+    EXPECT_FALSE(frame.value().cancelled);
+    std::printf("frame %zu: error %.3f mm, similarity %.4f, %ld DRRs\n", f, errorOf(t, frame.value()),
+                frame.value().similarity, frame.value().drrs);
+  }
+}
+
+TEST(CineTracker, ShuffledFrameIsFlaggedAndTheNextFramesTrackAgain) {
+  Tracked t = prepare(6);
+  auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
+  ASSERT_TRUE(tracker.ok()) << tracker.error();
+  ASSERT_TRUE(tracker.value().trackFirst(firstStart(t)).ok());
+  std::mt19937 random(3);
+  for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
+    std::vector<fct::XrayImage> images = t.sequence.frames[f];
+    if (f == 3) {
+      for (fct::XrayImage& image : images) std::shuffle(image.pixels.begin(), image.pixels.end(), random);
+    }
+    auto frame = tracker.value().trackNext(images);
+    ASSERT_TRUE(frame.ok()) << frame.error();
+    if (f == 3) {
+      EXPECT_EQ(frame.value().status, fct::TrackedFrameStatus::Lost);
+    } else {
+      EXPECT_NE(frame.value().status, fct::TrackedFrameStatus::Lost) << "frame " << f;
+      EXPECT_LT(errorOf(t, frame.value()), 1.0) << "frame " << f;
+    }
+  }
+}
+
+TEST(CineTracker, CancelledFrameIsMarked) {
+  Tracked t = prepare(2, 1);
+  auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
+  ASSERT_TRUE(tracker.ok()) << tracker.error();
+  ASSERT_TRUE(tracker.value().trackFirst(firstStart(t)).ok());
+  const std::atomic<bool> cancel{true};
+  auto frame = tracker.value().trackNext(t.sequence.frames[1], &cancel);
+  ASSERT_TRUE(frame.ok()) << frame.error();
+  EXPECT_TRUE(frame.value().cancelled);
+}
+
+TEST(CineTracker, RejectsBadOptionsAndFrames) {
+  Tracked t = prepare(2, 1);
+  fct::CineTrackerOptions options = fastTracker();
+  options.level = 7;
+  auto badLevel = fct::CineTracker::create(t.registrationCase, options);
+  ASSERT_FALSE(badLevel.ok());
+  EXPECT_NE(badLevel.error().find("level 7"), std::string::npos) << badLevel.error();
+  options = fastTracker();
+  options.similarityDrop = 1.5;
+  EXPECT_FALSE(fct::CineTracker::create(t.registrationCase, options).ok());
+
+  auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
+  ASSERT_TRUE(tracker.ok()) << tracker.error();
+  auto early = tracker.value().trackNext(t.sequence.frames[1]);
+  ASSERT_FALSE(early.ok());
+  EXPECT_NE(early.error().find("trackFirst"), std::string::npos) << early.error();
+  ASSERT_TRUE(tracker.value().trackFirst(firstStart(t)).ok());
+  auto twoImages = tracker.value().trackNext({t.sequence.frames[1][0], t.sequence.frames[1][0]});
+  ASSERT_FALSE(twoImages.ok());
+  EXPECT_NE(twoImages.error().find("2 images given for 1 views"), std::string::npos) << twoImages.error();
+}
+
+TEST(RegistrationCase, ReplaceXrayPreparesTheNewFrameAndKeepsTheViewOnBadInput) {
+  Tracked t = prepare(2, 1);
+  fct::RegistrationCase& c = t.registrationCase;
+  const std::vector<float> frame0 = c.prepared(0).pyramid.level(1).image.pixels;
+  ASSERT_TRUE(c.rois(0, 1, 7, 0.1).ok());
+
+  ASSERT_TRUE(c.replaceXray(0, t.sequence.frames[1][0]).ok());
+  const std::vector<float> frame1 = c.prepared(0).pyramid.level(1).image.pixels;
+  EXPECT_NE(frame0, frame1);
+  ASSERT_TRUE(c.rois(0, 1, 7, 0.1).ok());  // statistics recomputed on the new frame
+
+  fct::XrayImage small = t.sequence.frames[1][0];
+  small.cols = small.rows = 64;
+  small.pixels.resize(64 * 64);
+  auto wrongSize = c.replaceXray(0, small);
+  ASSERT_FALSE(wrongSize.ok());
+  EXPECT_NE(wrongSize.error().find("64x64"), std::string::npos) << wrongSize.error();
+  fct::XrayImage blank = t.sequence.frames[1][0];
+  std::fill(blank.pixels.begin(), blank.pixels.end(), 1000.0f);
+  auto constant = c.replaceXray(0, blank);
+  ASSERT_FALSE(constant.ok());
+  EXPECT_NE(constant.error().find("blank"), std::string::npos) << constant.error();
+  EXPECT_FALSE(c.replaceXray(5, t.sequence.frames[1][0]).ok());
+  EXPECT_EQ(c.prepared(0).pyramid.level(1).image.pixels, frame1);
+}
