@@ -25,15 +25,9 @@ void mirrorColumns(XrayImage& image) {
   image.camera.reset();
 }
 
-}  // namespace
-
-Result<RegistrationView> RegistrationViewLoader::loadView(const ViewSpec& spec) {
-  if (spec.imagePath.empty()) {
-    return fail(fmt::format("view '{}' has no image; registration needs an X-ray per view: add the key \"image\" "
-                            "with the view's X-ray file",
-                            spec.name));
-  }
-  auto image = XrayLoader::load(spec.imagePath, spec.frame);
+/// The view's image from frame `frame` of `imagePath`, flipped and dewarped as the view says, with its spheres.
+Result<RegistrationView> loadImage(const ViewSpec& spec, const std::filesystem::path& imagePath, int frame) {
+  auto image = XrayLoader::load(imagePath, frame);
   if (!image) return fail(fmt::format("view '{}': {}", spec.name, image.error()));
   std::vector<std::string> warnings;
   for (const std::string& warning : image.warnings()) warnings.push_back(fmt::format("view '{}': {}", spec.name, warning));
@@ -57,6 +51,29 @@ Result<RegistrationView> RegistrationViewLoader::loadView(const ViewSpec& spec) 
   Result<RegistrationView> loaded(std::move(view));
   for (std::string& warning : warnings) loaded.addWarning(std::move(warning));
   return loaded;
+}
+
+}  // namespace
+
+Result<RegistrationView> RegistrationViewLoader::loadView(const ViewSpec& spec) {
+  if (spec.imagePath.empty()) {
+    return fail(fmt::format("view '{}' has no image; registration needs an X-ray per view: add the key \"image\" "
+                            "with the view's X-ray file",
+                            spec.name));
+  }
+  return loadImage(spec, spec.imagePath, spec.frame);
+}
+
+Result<RegistrationView> RegistrationViewLoader::loadFrame(const ViewSpec& spec, int frame) {
+  if (!spec.sequence) {
+    return fail(fmt::format("view '{}' has no sequence; tracking needs a \"sequence\" of frames per view", spec.name));
+  }
+  if (frame < 0 || frame >= spec.sequence->frameCount()) {
+    return fail(fmt::format("view '{}': frame {} is outside its sequence of {} frames", spec.name, frame,
+                            spec.sequence->frameCount()));
+  }
+  const auto [path, fileFrame] = spec.sequence->frame(frame);
+  return loadImage(spec, path, fileFrame);
 }
 
 Result<std::vector<RegistrationView>> RegistrationViewLoader::load(const std::filesystem::path& viewFile) {

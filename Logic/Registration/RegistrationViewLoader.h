@@ -29,6 +29,9 @@ class RegistrationViewLoader {
   /// its size is not the detector's or its dewarp file is unusable; the
   /// image's warnings are on the Result, prefixed "view '<name>': ".
   static Result<RegistrationView> loadView(const ViewSpec& spec);
+  /// Frame `frame` (0-based) of the view's sequence, loaded as loadView() loads the image; fails as loadView() does,
+  /// and naming the view when it has no sequence or the frame is out of range.
+  static Result<RegistrationView> loadFrame(const ViewSpec& spec, int frame);
 };
 
 }  // namespace fct

@@ -3,9 +3,11 @@
 #include <fmt/core.h>
 
 #include <set>
+#include <tuple>
 
 #include "Base/JsonDocument.h"
 #include "Base/JsonReader.h"
+#include "IO/Dicom/XrayDicomReader.h"
 
 namespace fct {
 
@@ -45,6 +47,92 @@ void readImage(JsonReader& reader, const std::filesystem::path& folder, ViewSpec
                                           "file's folder '{}'",
                                           view.imagePath.string(), folder.string()));
   }
+}
+
+/// `relative` made absolute against `folder`; rejects `key` when the file does not exist.
+std::filesystem::path existingFile(JsonReader& reader, const std::string& key, const std::filesystem::path& folder,
+                                   const std::string& relative) {
+  std::filesystem::path path = (folder / std::filesystem::path(relative)).lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    reader.rejectKey(key, fmt::format("names '{}', which does not exist; paths are relative to the view file's "
+                                      "folder '{}'",
+                                      path.string(), folder.string()));
+  }
+  return path;
+}
+
+/// The frame range of a multi-frame sequence: "all" or [first, last] (0-based, inclusive), checked against the file's
+/// frame count (its DICOM header).
+void readFrameRange(JsonReader& reader, ViewSequence& sequence) {
+  const json* frames = reader.find("sequence.frames");
+  const bool all = !frames || (frames->is_string() && frames->get<std::string>() == "all");
+  if (!all && !(frames->is_array() && frames->size() == 2 && (*frames)[0].is_number_integer() &&
+                (*frames)[1].is_number_integer())) {
+    return reader.rejectKey("sequence.frames", fmt::format("must be \"all\" or [first, last] (0-based frame numbers), "
+                                                           "got {}",
+                                                           JsonReader::describe(*frames)));
+  }
+  auto header = XrayDicomReader::readHeader(sequence.multiFramePath);
+  if (!header) return reader.rejectKey("sequence.path", header.error());
+  const int count = header.value().frames;
+  sequence.allFrames = all;
+  sequence.firstFrame = all ? 0 : (*frames)[0].get<int>();
+  sequence.lastFrame = all ? count - 1 : (*frames)[1].get<int>();
+  if (sequence.firstFrame < 0 || sequence.lastFrame < sequence.firstFrame || sequence.lastFrame >= count) {
+    reader.rejectKey("sequence.frames", fmt::format("[{}, {}] is not a frame range of '{}', which has {} frames (0 to "
+                                                    "{}); give first <= last within them",
+                                                    sequence.firstFrame, sequence.lastFrame,
+                                                    sequence.multiFramePath.string(), count, count - 1));
+  }
+}
+
+/// A view's frame sequence: {"path": "cine.dcm", "frames": "all" | [first, last]} or ["f000.tif", ...] (paths relative
+/// to `folder`); the view's imagePath/frame become the first frame.
+void readSequence(JsonReader& reader, const std::filesystem::path& folder, ViewSpec& view,
+                  std::vector<std::string>& warnings) {
+  const json* sequenceJson = reader.find("sequence");
+  if (!sequenceJson) return;
+  if (reader.has("image")) return reader.reject("gives both \"image\" and \"sequence\"; keep only one");
+  ViewSequence sequence;
+  if (sequenceJson->is_array() && !sequenceJson->empty()) {
+    for (std::size_t i = 0; i < sequenceJson->size() && reader.ok(); ++i) {
+      const std::string key = fmt::format("sequence[{}]", i);
+      if (!(*sequenceJson)[i].is_string()) return reader.rejectKey(key, "must be an image file name");
+      sequence.files.push_back(existingFile(reader, key, folder, (*sequenceJson)[i].get<std::string>()));
+    }
+  } else if (sequenceJson->is_object()) {
+    const std::string relative = reader.string("sequence.path");
+    if (!reader.ok()) return;
+    sequence.multiFramePath = existingFile(reader, "sequence.path", folder, relative);
+    if (!reader.ok()) return;
+    readFrameRange(reader, sequence);
+    addWarnings(warnings, reader.unknownKeys({"path", "frames"}, "sequence"));
+  } else {
+    return reader.rejectKey("sequence", fmt::format("must be a non-empty list of image files or {{\"path\": "
+                                                    "\"cine.dcm\", \"frames\": \"all\" | [first, last]}}, got {}",
+                                                    JsonReader::describe(*sequenceJson)));
+  }
+  if (!reader.ok()) return;
+  std::tie(view.imagePath, view.frame) = sequence.frame(0);
+  view.sequence = std::move(sequence);
+}
+
+/// Fails unless every view has a sequence of the same frame count, or none has one.
+Status checkFrameCounts(const std::vector<ViewSpec>& views, const std::string& file) {
+  const ViewSpec& first = views.front();
+  for (const ViewSpec& view : views) {
+    const int count = view.sequence ? view.sequence->frameCount() : 0;
+    const int firstCount = first.sequence ? first.sequence->frameCount() : 0;
+    if (count == firstCount) continue;
+    const auto describe = [](const ViewSpec& v) {
+      return v.sequence ? fmt::format("{} frames", v.sequence->frameCount()) : std::string("no sequence");
+    };
+    return fail(fmt::format("{}: view '{}' has {} but view '{}' has {}; every view needs a sequence of the same "
+                            "number of frames",
+                            file, view.name, describe(view), first.name, describe(first)));
+  }
+  return Ok{};
 }
 
 /// The dewarp file path of a view ("dewarp": "intensifier.dewarp.json"), made absolute against `folder`; checks that
@@ -127,6 +215,17 @@ std::string pathForFile(const std::filesystem::path& imagePath, const std::files
   return absolute.generic_string();
 }
 
+/// A sequence as the view file gives it (paths as pathForFile writes them).
+ordered_json sequenceJson(const ViewSequence& sequence, const std::filesystem::path& folder) {
+  if (sequence.multiFramePath.empty()) {
+    ordered_json files = ordered_json::array();
+    for (const std::filesystem::path& file : sequence.files) files.push_back(pathForFile(file, folder));
+    return files;
+  }
+  ordered_json frames = sequence.allFrames ? ordered_json("all") : ordered_json::array({sequence.firstFrame, sequence.lastFrame});
+  return ordered_json{{"path", pathForFile(sequence.multiFramePath, folder)}, {"frames", std::move(frames)}};
+}
+
 }  // namespace
 
 Result<std::vector<ViewSpec>> ViewFile::read(const std::filesystem::path& path) {
@@ -159,16 +258,18 @@ Result<std::vector<ViewSpec>> ViewFile::read(const std::filesystem::path& path) 
     }
     JsonReader reader(viewJson, fmt::format("{}: view '{}'", file, view.name));
     readImage(reader, folder, view, warnings);
+    readSequence(reader, folder, view, warnings);
     readDewarp(reader, folder, view);
     readCamera(reader, view);
     readSpheres(reader, view, warnings);
     if (!reader.ok()) return fail(reader.error());
     addWarnings(warnings, reader.unknownKeys({"name", "image", "detector", "source_to_detector_mm",
                                               "principal_point_px", "T_world_from_camera", "projection_matrix",
-                                              "calibration_spheres_px", "dewarp"}));
+                                              "calibration_spheres_px", "dewarp", "sequence"}));
     addWarnings(warnings, reader.unknownKeys({"cols", "rows", "pixel_spacing_mm"}, "detector"));
     views.push_back(std::move(view));
   }
+  if (Status counts = checkFrameCounts(views, file); !counts) return fail(counts.error());
   Result<std::vector<ViewSpec>> result(std::move(views));
   for (std::string& warning : warnings) result.addWarning(std::move(warning));
   return result;
@@ -190,7 +291,9 @@ Status ViewFile::write(const std::vector<ViewSpec>& views, const std::filesystem
     }
     ordered_json v;
     v["name"] = view.name;
-    if (!view.imagePath.empty()) {
+    if (view.sequence) {
+      v["sequence"] = sequenceJson(*view.sequence, folder);
+    } else if (!view.imagePath.empty()) {
       v["image"] = ordered_json{{"path", pathForFile(view.imagePath, folder)}, {"frame", view.frame}};
       if (view.mirrorColumns) v["image"]["mirror_columns"] = true;
     }
