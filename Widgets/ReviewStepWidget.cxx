@@ -40,18 +40,6 @@ void setButtonColour(QPushButton* button, const QColor& colour) {
   button->setStyleSheet(QStringLiteral("background-color: %1;").arg(colour.name()));
 }
 
-std::vector<std::vector<Eigen::Vector2d>> toPolylines(const std::vector<PixelContour>& contours) {
-  std::vector<std::vector<Eigen::Vector2d>> polylines;
-  polylines.reserve(contours.size());
-  for (const PixelContour& contour : contours) {
-    std::vector<Eigen::Vector2d> line;
-    line.reserve(contour.size());
-    for (const Eigen::Vector2i& p : contour) line.push_back(p.cast<double>());
-    polylines.push_back(std::move(line));
-  }
-  return polylines;
-}
-
 /// The DRR as an 8-bit grey image shaded like the X-ray (white where rays miss the bone, dark through much of it),
 /// scaled to its 99th percentile line integral.
 QImage greyDrr(const FloatImage& drr) {
@@ -334,7 +322,7 @@ void ReviewStepWidget::refresh() {
       if (!*pose) continue;
       auto projected = m_overlay->contours(views[v].camera, **pose);
       if (projected) {
-        contours->back() = toPolylines(projected.value());
+        contours->back() = XrayViewWidget::polylines(projected.value());
       } else {
         problems << QString::fromStdString(views[v].name + ": " + projected.error());
       }

@@ -171,6 +171,8 @@ class StudioDocument : public QObject {
   void setRegistrationOptions(const StudioRegistrationOptions& options);
   /// The XrayPreparation options of the ROI parameters' exclusions (view spheres are added per view by the case).
   XrayPreparationOptions preparationOptions() const;
+  /// The options of the case of the current inputs; fails when the CT or the views are missing or the method is bad.
+  Result<RegistrationCaseOptions> caseOptions() const;
   /// The registration case of the current CT, views, exclusions and DRR method, prepared on first call and kept
   /// until one of those changes. Slow on first call (seconds for a large CT; the widgets use
   /// prepareCaseInBackground() instead); joins a background preparation under way. Shared with whoever runs on it:
@@ -271,8 +273,6 @@ class StudioDocument : public QObject {
   void touch();
   /// Drops the prepared case, and a background preparation of the old inputs.
   void invalidateCase();
-  /// The options of the case of the current inputs; fails when the CT or the views are missing or the method is bad.
-  Result<RegistrationCaseOptions> caseOptions() const;
   /// Takes the outcome of the background preparation (waiting for it), keeps its case and emits
   /// casePreparationFinished(); fails with its error.
   Status adoptPreparation();

@@ -21,6 +21,7 @@
 #include "Widgets/LandmarkStepWidget.h"
 #include "Widgets/RegisterStepWidget.h"
 #include "Widgets/ReviewStepWidget.h"
+#include "Widgets/TrackStepWidget.h"
 #include "Widgets/RoiStepWidget.h"
 #include "Widgets/Scene3DWidget.h"
 #include "Widgets/SessionAutosave.h"
@@ -161,6 +162,7 @@ StudioMainWindow::StudioMainWindow(std::filesystem::path autosavePath, QWidget* 
   auto* registration = addStep(tr("Register"), new RegisterStepWidget(m_document, this));
   connect(registration, &RegisterStepWidget::statusMessage, this, &StudioMainWindow::showStatus);
   addStep(tr("Review"), new ReviewStepWidget(m_document, this));
+  addStep(tr("Track"), new TrackStepWidget(m_document, this));
 
   buildMenus();
   updateTitle();

@@ -1,6 +1,6 @@
 #pragma once
 // StudioMainWindow: the FluoroCT Studio main window, laid out as 3D Slicer is: the module panel on the left with the
-// workflow steps (Data, Initial pose, ROIs, Register, Review; one widget each), the views on the right (one view per
+// workflow steps (Data, Initial pose, ROIs, Register, Review, Track; one widget each), the views on the right (one view per
 // X-ray on top; the axial, coronal and sagittal CT slices and the 3D view below, crosshair linked across the slices)
 // and a status line. It owns the StudioDocument, its session file (save, open, recent sessions) and its autosave
 // side file; unsaved changes are never dropped without asking.

@@ -82,4 +82,16 @@ QString XrayViewWidget::presetName(XrayWindowPreset preset) {
   return {};
 }
 
+std::vector<std::vector<Eigen::Vector2d>> XrayViewWidget::polylines(const std::vector<PixelContour>& contours) {
+  std::vector<std::vector<Eigen::Vector2d>> lines;
+  lines.reserve(contours.size());
+  for (const PixelContour& contour : contours) {
+    std::vector<Eigen::Vector2d> line;
+    line.reserve(contour.size());
+    for (const Eigen::Vector2i& p : contour) line.push_back(p.cast<double>());
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
 }  // namespace fct

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "Evaluation/ContourOverlay.h"
 #include "Image/XrayImage.h"
 #include "Widgets/ImageViewWidget.h"
 
@@ -44,6 +45,8 @@ class XrayViewWidget : public ImageViewWidget {
   void applyWindowPreset(XrayWindowPreset preset);
   /// Display name of a preset ("Automatic (patient)", "Whole field", "Full range").
   static QString presetName(XrayWindowPreset preset);
+  /// Projected bone outlines (ContourOverlay::contours) as the polylines of setPolylineLayer, in pixels.
+  static std::vector<std::vector<Eigen::Vector2d>> polylines(const std::vector<PixelContour>& contours);
   /// The field-of-view mask the windows are taken from (row-major, 1 = inside; all ones when none was found).
   const std::vector<std::uint8_t>& fieldMask() const { return m_field; }
 

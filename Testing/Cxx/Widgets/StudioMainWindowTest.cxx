@@ -79,10 +79,11 @@ TEST_F(StudioMainWindowTest, ShowsTitleMenusDataStepAndReadyStatus) {
   EXPECT_TRUE(window.windowTitle().contains(QStringLiteral("FluoroCT Studio")));
   EXPECT_FALSE(window.menuBar()->actions().isEmpty());
   EXPECT_EQ(window.statusBar()->currentMessage(), QStringLiteral("Ready"));
-  ASSERT_EQ(window.stepCount(), 5);
+  ASSERT_EQ(window.stepCount(), 6);
   EXPECT_EQ(window.stepTitle(0), QStringLiteral("Data"));
   EXPECT_EQ(window.stepTitle(1), QStringLiteral("Initial pose"));
   EXPECT_EQ(window.stepTitle(4), QStringLiteral("Review"));
+  EXPECT_EQ(window.stepTitle(5), QStringLiteral("Track"));
   EXPECT_TRUE(window.xrayViews().empty());
 }
 
