@@ -1,5 +1,5 @@
 // fluoroct-studio: the FluoroCT desktop program (thin entry point).
-// fluoroct-studio [SESSION | --case DIR] [--step NAME] [--register] [--screenshot FILE]
+// fluoroct-studio [SESSION | --case DIR] [--step NAME] [--register] [--track SEQUENCE] [--screenshot FILE]
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QDir>
@@ -13,6 +13,7 @@
 #include "Widgets/DataStepWidget.h"
 #include "Widgets/RegisterStepWidget.h"
 #include "Widgets/StudioMainWindow.h"
+#include "Widgets/TrackStepWidget.h"
 
 namespace {
 
@@ -42,7 +43,7 @@ int main(int argc, char** argv) {
                      "optionally initial_pose.json and truth_pose.json."),
       QStringLiteral("dir"));
   const QCommandLineOption step(QStringLiteral("step"),
-                                QStringLiteral("Show this workflow step: data, initial-pose, rois, register, review."),
+                                QStringLiteral("Show this workflow step: data, initial-pose, rois, register, review, track."),
                                 QStringLiteral("name"));
   const QCommandLineOption screenshot(
       QStringLiteral("screenshot"),
@@ -52,9 +53,16 @@ int main(int argc, char** argv) {
       QStringLiteral("register"),
       QStringLiteral("Once the case is loaded, run a registration as the Register step's Run button does (with "
                      "--screenshot: the picture is taken when it has finished)."));
+  const QCommandLineOption runTracking(
+      QStringLiteral("track"),
+      QStringLiteral("Once the case is loaded (and registered, with --register), load the sequence of this view file "
+                     "into the Track step and track it as its Track button does (with --screenshot: the picture is "
+                     "taken when it has finished)."),
+      QStringLiteral("sequence"));
   parser.addOption(caseFolder);
   parser.addOption(step);
   parser.addOption(runRegistration);
+  parser.addOption(runTracking);
   parser.addOption(screenshot);
   parser.process(app);
   const QStringList positional = parser.positionalArguments();
@@ -102,17 +110,32 @@ int main(int argc, char** argv) {
       QApplication::exit(0);  // not quit(): that would close the window and ask about the unsaved case
     });
   };
-  // After loading: optionally register (the Register step reports any error in its own log), then the screenshot.
-  const auto afterLoad = [&window, &parser, &runRegistration, take] {
-    auto* registerStep = window.findChild<fct::RegisterStepWidget*>();
-    if (!parser.isSet(runRegistration) || registerStep == nullptr) {
+  // After registering: optionally track a sequence (the Track step shows any error in its message line), then the
+  // screenshot.
+  const auto afterRegistration = [&window, &parser, &runTracking, take] {
+    auto* trackStep = window.findChild<fct::TrackStepWidget*>();
+    if (!parser.isSet(runTracking) || trackStep == nullptr ||
+        !trackStep->loadSequence(parser.value(runTracking).toStdString())) {
       take();
       return;
     }
-    QObject::connect(registerStep, &fct::RegisterStepWidget::runningChanged, &window, [take](bool running) {
+    QObject::connect(trackStep, &fct::TrackStepWidget::runningChanged, &window, [take](bool running) {
       if (!running) take();
     });
-    if (!registerStep->run()) take();
+    trackStep->startTracking();
+    if (!trackStep->isRunning()) take();
+  };
+  // After loading: optionally register (the Register step reports any error in its own log), then the rest.
+  const auto afterLoad = [&window, &parser, &runRegistration, afterRegistration] {
+    auto* registerStep = window.findChild<fct::RegisterStepWidget*>();
+    if (!parser.isSet(runRegistration) || registerStep == nullptr) {
+      afterRegistration();
+      return;
+    }
+    QObject::connect(registerStep, &fct::RegisterStepWidget::runningChanged, &window, [afterRegistration](bool running) {
+      if (!running) afterRegistration();
+    });
+    if (!registerStep->run()) afterRegistration();
   };
   if (loading && window.dataStep()->isBusy()) {
     QObject::connect(window.dataStep(), &fct::DataStepWidget::loadFinished, &window, afterLoad);
