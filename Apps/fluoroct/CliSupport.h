@@ -66,6 +66,8 @@ void registerViewsCommand(CLI::App& app, CommandAction& action);
 void registerSimulateCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct register`: registers a CT to the X-ray views of a view file and writes the result JSON.
 void registerRegisterCommand(CLI::App& app, CommandAction& action);
+/// `fluoroct track`: follows the bone through a fluoroscopy sequence and writes the per-frame poses.
+void registerTrackCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct tre`: prints the pose error (sTRE, mTRE, rotation, translation) of an estimate against the truth.
 void registerTreCommand(CLI::App& app, CommandAction& action);
 /// `fluoroct evaluate`: runs an evaluation study and writes trials.csv, report.md and charts.

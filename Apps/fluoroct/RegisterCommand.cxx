@@ -16,11 +16,10 @@
 
 #include "Base/JsonDocument.h"
 #include "CliSupport.h"
+#include "InitialPoseInput.h"
 #include "Evaluation/ContourOverlay.h"
-#include "InitialPose/LandmarkPoseEstimator.h"
 #include "Interop/IgtlTransformSender.h"
 #include "IO/Project/ItkTransformFile.h"
-#include "IO/Project/LandmarkPairFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Xray/ImageFileWriter.h"
@@ -74,64 +73,6 @@ Status writeMaskPng(const ValidMask& mask, const fs::path& path) {
   return ImageFileWriter::writePng16(image, path, 0.0f, 1.0f);
 }
 
-/// The initial pose and, for RESULT.json, where it came from.
-struct InitialPose {
-  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();
-  nlohmann::ordered_json source;
-};
-
-/// The residuals of a landmark estimate as RESULT.json lists them.
-nlohmann::ordered_json residualsJson(const LandmarkPoseEstimate& e) {
-  nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
-  for (const LandmarkResidual& r : e.residuals) {
-    nlohmann::ordered_json perView = nlohmann::ordered_json::object();
-    for (const auto& [viewName, px] : r.reprojection_px) perView[viewName] = px;
-    nlohmann::ordered_json entry{{"name", r.name}, {"reprojection_px", perView}};
-    if (std::isfinite(r.distance_mm)) entry["distance_mm"] = r.distance_mm;
-    residuals.push_back(std::move(entry));
-  }
-  return residuals;
-}
-
-/// The initial pose estimated from the landmark pair file `path` with the views' cameras.
-Result<InitialPose> poseFromLandmarks(const std::string& path, const std::vector<RegistrationView>& views) {
-  auto pairs = LandmarkPairFile::read(path);
-  if (!pairs) return fail("--landmarks: " + pairs.error());
-  printWarnings(pairs.warnings());
-  const LandmarkPairSet& set = pairs.value();
-  std::map<std::string, Camera> cameras;
-  for (const RegistrationView& view : views) cameras.emplace(view.name, view.camera);
-  for (const auto& [viewName, clicks] : set.landmarks.imageByView) {
-    if (!cameras.count(viewName)) {
-      std::vector<std::string> names;
-      for (const RegistrationView& view : views) names.push_back(view.name);
-      return fail(fmt::format("{}: landmarks are clicked in view '{}', which the view file does not have (views: {}); "
-                              "the landmark and view files must name the same views",
-                              set.imageFile.string(), viewName, fmt::join(names, ", ")));
-    }
-  }
-  auto estimate = set.method == LandmarkPoseMethod::Triangulation
-                      ? LandmarkPoseEstimator::fromTriangulation(set.landmarks, cameras)
-                      : LandmarkPoseEstimator::fromReprojection(set.landmarks, cameras);
-  if (!estimate) return fail("initial pose from landmarks: " + estimate.error());
-  const LandmarkPoseEstimate& e = estimate.value();
-  nlohmann::ordered_json source{{"source", "landmarks"},
-                                {"path", path},
-                                {"method", e.method},
-                                {"rms_reprojection_px", e.rmsReprojection_px}};
-  if (std::isfinite(e.rms3d_mm)) source["rms_3d_mm"] = e.rms3d_mm;
-  source["residuals"] = residualsJson(e);
-  return InitialPose{e.T_world_from_ct, std::move(source)};
-}
-
-/// The initial pose from --init or --landmarks.
-Result<InitialPose> initialPose(const Options& o, const std::vector<RegistrationView>& views) {
-  if (o.init.empty()) return poseFromLandmarks(o.landmarks, views);
-  auto pose = readPoseOrTransform(o.init);
-  if (!pose) return fail("--init: " + pose.error());
-  return InitialPose{pose.value(), nlohmann::ordered_json{{"source", "pose file"}, {"path", o.init}}};
-}
-
 /// Everything register reads before it prepares the case.
 struct Inputs {
   DrrMethod method = DrrMethod::Siddon;
@@ -144,9 +85,7 @@ struct Inputs {
 
 /// Checks the options and reads the views, the initial pose, the truth and the CT; warnings go to stderr.
 Result<Inputs> readInputs(const Options& o) {
-  if (o.init.empty() == o.landmarks.empty()) {
-    return fail("give the initial pose with exactly one of --init POSE.json|POSE.tfm or --landmarks LM.json");
-  }
+  if (Status flags = checkInitialPoseFlags(o.init, o.landmarks); !flags) return fail(flags.error());
   if (!o.tfm.empty()) {
     if (Status writable = checkWritableTransform(o.tfm); !writable) return fail("--tfm: " + writable.error());
   }
@@ -161,7 +100,7 @@ Result<Inputs> readInputs(const Options& o) {
   if (!views) return fail("--views: " + views.error());
   printWarnings(views.warnings());
   in.views = std::move(views).value();
-  auto initial = initialPose(o, in.views);
+  auto initial = readInitialPose(o.init, o.landmarks, in.views);
   if (!initial) return fail(initial.error());
   in.initial = std::move(initial).value();
   if (!o.truth.empty()) {

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   registerViewsCommand(app, action);
   registerSimulateCommand(app, action);
   registerRegisterCommand(app, action);
+  registerTrackCommand(app, action);
   registerTreCommand(app, action);
   registerEvaluateCommand(app, action);
   registerDewarpCalibrateCommand(app, action);

@@ -37,11 +37,11 @@ struct ViewSpec {
   std::string name;
   std::filesystem::path imagePath;  ///< empty if none; absolute after read; a sequence's first frame when it has one
   int frame = 0;                    ///< frame of a multi-frame image file
-  std::optional<ViewSequence> sequence;  ///< the view's frame sequence ("sequence" instead of "image"), if any
   Camera camera;
   std::vector<PixelCircle> calibrationSpheres;  ///< shadows of calibration-grid spheres, masked out of the comparison
   std::filesystem::path dewarpPath;  ///< the view's dewarp file (DewarpFile); empty if none; absolute after read
   bool mirrorColumns = false;  ///< flip the image left-right on load (a DICOM stored mirrored against the camera)
+  std::optional<ViewSequence> sequence;  ///< the view's frame sequence ("sequence" instead of "image"), if any
 };
 
 /// Reads and writes view files.

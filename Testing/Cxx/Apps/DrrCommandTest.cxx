@@ -33,12 +33,12 @@ struct DrrFixture {
     EXPECT_TRUE(fct::VolumeFileIO::write(volume, ct).ok());
     fct::ViewSpec ap{"AP", {}, 0, fct::Camera::lookingAt(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 600.0,
                                                          1000.0, 65, 49, 1.0),
-                     {}, {}};
+                     {}, {}, false, std::nullopt};
     fct::ViewSpec lat{"Left lat", {}, 0,
                       fct::Camera::lookingAt(Eigen::Vector3d::Zero(),
                                              Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitY()).toRotationMatrix(), 600.0,
                                              1000.0, 40, 30, 1.5),
-                      {}, {}};
+                      {}, {}, false, std::nullopt};
     EXPECT_TRUE(fct::ViewFile::write({ap, lat}, views).ok());
     fs::create_directories(out);
   }

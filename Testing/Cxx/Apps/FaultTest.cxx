@@ -1,6 +1,7 @@
 // Faults the CLI survives: a file-size limit (as a full disk) while writing RESULT.json, a truncated Transgraph cache
 // (rebuilt with a warning), kill -9 in the middle of a study (the resume loses at most the trials that were running),
-// and Ctrl-C during `register` (the best pose so far is written, marked cancelled).
+// Ctrl-C during `register` (the best pose so far is written, marked cancelled) and during `track` (the frames so far
+// are written, marked cancelled).
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -166,6 +167,30 @@ TEST(RegisterFault, CtrlCWritesTheBestPoseSoFarMarkedCancelled) {
   auto pose = fct::PoseFile::read(dir / "RESULT.json");
   ASSERT_TRUE(pose.ok()) << pose.error();
   EXPECT_TRUE(pose.value().matrix().allFinite());
+}
+
+TEST(TrackFault, CtrlCWritesTheFramesSoFarMarkedCancelled) {
+  const fs::path dir = fct::test::scratchDir();
+  const std::vector<Eigen::Isometry3d> truth = fct::test::makeTrackCase(dir, 40);
+  ASSERT_TRUE(fct::PoseFile::write(fct::test::perturbed(truth[0]), dir / "init.json").ok());
+  BackgroundCli tracking(fmt::format("track --ct '{}' --views '{}' --init '{}' --preset fast --level 0 --out '{}'",
+                                     (dir / "ct.nrrd").string(), (dir / "track_views.json").string(),
+                                     (dir / "init.json").string(), (dir / "out").string()),
+                         dir);
+  ASSERT_TRUE(tracking.waitForStderr([](const std::string& err) { return err.find("frame    2/") != std::string::npos; }))
+      << "the tracking ended before frame 2: " << tracking.stderrText();
+  tracking.signal(SIGINT);
+  const int status = tracking.wait();
+  ASSERT_TRUE(WIFEXITED(status)) << "Ctrl-C ended the process instead of stopping the tracking";
+  EXPECT_EQ(WEXITSTATUS(status), 0) << tracking.stderrText();
+  EXPECT_NE(fct::test::readText(dir / "stdout.txt").find("cancelled after"), std::string::npos);
+  auto result = fct::JsonDocument::parse(dir / "out" / "track.json");
+  ASSERT_TRUE(result.ok()) << result.error();
+  EXPECT_EQ(result.value().at("cancelled"), true);
+  const std::size_t done = result.value().at("frames").size();
+  EXPECT_GE(done, 3u);
+  EXPECT_LT(done, 40u);
+  EXPECT_TRUE(fs::exists(dir / "out" / "track.csv"));
 }
 
 TEST(RegisterFault, TruncatedTransgraphCacheIsRebuiltWithAWarning) {

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "IO/Project/PoseFile.h"
+#include "IO/Project/ViewFile.h"
 #include "TestSupport.h"
 
 namespace fct::test {
@@ -39,6 +40,41 @@ inline Eigen::Isometry3d perturbed(const Eigen::Isometry3d& truth) {
   start.translation() += Eigen::Vector3d(2.0, -1.5, 1.0);
   start.linear() = Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitZ()).toRotationMatrix() * start.linear();
   return start;
+}
+
+/// A small simulated biplane sequence in `dir` for `fluoroct track`: ct.nrrd, `frames` frames of 128x128 at 2.4 mm
+/// (frame f simulated into frame<f>/ with the bone moved by f * (1, -0.5, 0.5) mm and turned by f * 0.4 deg), and
+/// track_views.json whose views give the frames as "sequence" lists. Returns the true pose of every frame.
+inline std::vector<Eigen::Isometry3d> makeTrackCase(const std::filesystem::path& dir, int frames) {
+  auto run = runCli(fmt::format("phantom --out '{}' --dims 80 80 60 --spacing-mm 2", (dir / "ct.nrrd").string()));
+  EXPECT_EQ(run.exitCode, 0) << run.err;
+  run = runCli(fmt::format("views --ct '{}' --out '{}' --count 2 --detector 128x128 --pixel-mm 2.4 --sid-mm 1000 "
+                           "--sad-mm 700",
+                           (dir / "ct.nrrd").string(), (dir / "views.json").string()));
+  EXPECT_EQ(run.exitCode, 0) << run.err;
+  std::vector<Eigen::Isometry3d> truth;
+  for (int f = 0; f < frames; ++f) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = Eigen::AngleAxisd(0.007 * f, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    pose.translation() = Eigen::Vector3d(2.0 + f, -1.0 - 0.5 * f, 3.0 + 0.5 * f);
+    const std::filesystem::path poseFile = dir / fmt::format("truth{}.json", f);
+    EXPECT_TRUE(PoseFile::write(pose, poseFile).ok());
+    run = runCli(fmt::format("simulate --ct '{}' --views '{}' --pose '{}' --out '{}' --model physical "
+                             "--noise-photons 20000 --seed {}",
+                             (dir / "ct.nrrd").string(), (dir / "views.json").string(), poseFile.string(),
+                             (dir / fmt::format("frame{}", f)).string(), 1 + 2 * f));
+    EXPECT_EQ(run.exitCode, 0) << run.err;
+    truth.push_back(pose);
+  }
+  auto views = ViewFile::read(dir / "frame0" / "views.json");
+  EXPECT_TRUE(views.ok()) << views.error();
+  for (ViewSpec& view : views.value()) {
+    ViewSequence sequence;
+    for (int f = 0; f < frames; ++f) sequence.files.push_back(dir / fmt::format("frame{}", f) / (view.name + ".png"));
+    view.sequence = std::move(sequence);
+  }
+  EXPECT_TRUE(ViewFile::write(views.value(), dir / "track_views.json").ok());
+  return truth;
 }
 
 /// True when the command failed with status 2 and printed exactly one line "error: ..." on stderr.

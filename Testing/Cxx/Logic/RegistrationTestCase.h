@@ -23,9 +23,18 @@
 #include "Registration/RegistrationCase.h"
 #include "Search/PoseOptimizer.h"
 #include "Simulation/DrrXraySimulator.h"
+#include "Simulation/PhantomBuilder.h"
 #include "Simulation/StandardViews.h"
 
 namespace fct::test {
+
+/// The built-in phantom at 80 x 80 x 60 voxels of 2 mm: a small CT for fast registration tests.
+inline Volume smallPhantom() {
+  PhantomOptions options;
+  options.dims = Eigen::Vector3i(80, 80, 60);
+  options.spacing_mm = 2.0;
+  return PhantomBuilder::build(options).value();
+}
 
 /// Detector and noise of a simulated case.
 struct KnownTruthOptions {

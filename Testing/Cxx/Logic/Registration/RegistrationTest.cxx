@@ -16,13 +16,6 @@
 
 namespace {
 
-fct::Volume smallPhantom() {
-  fct::PhantomOptions options;
-  options.dims = Eigen::Vector3i(80, 80, 60);
-  options.spacing_mm = 2.0;
-  return fct::PhantomBuilder::build(options).value();
-}
-
 struct Prepared {
   fct::test::KnownTruthCase simulated;
   fct::RegistrationCase registrationCase;
@@ -30,7 +23,7 @@ struct Prepared {
 
 Prepared preparePhantom(const fct::RegistrationCaseOptions& caseOptions = {},
                         const fct::test::KnownTruthOptions& truthOptions = {}) {
-  auto simulated = fct::test::simulateCase(smallPhantom(), truthOptions);
+  auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), truthOptions);
   EXPECT_TRUE(simulated.ok()) << simulated.error();
   auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, caseOptions);
   EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
@@ -271,7 +264,7 @@ TEST(Registration, FailsClearlyOnAPixelSetThatKeepsNothing) {
 }
 
 TEST(RegistrationCase, FailsClearlyOnAConstantXrayAndAMismatchedDetector) {
-  auto simulated = fct::test::simulateCase(smallPhantom());
+  auto simulated = fct::test::simulateCase(fct::test::smallPhantom());
   ASSERT_TRUE(simulated.ok()) << simulated.error();
   auto views = simulated.value().views;
   std::fill(views[1].xray.pixels.begin(), views[1].xray.pixels.end(), 1234.0f);
@@ -295,7 +288,7 @@ TEST(RegistrationCase, FailsClearlyOnAConstantXrayAndAMismatchedDetector) {
 }
 
 TEST(RegistrationCase, ReportsEachPreparationStepAndStopsWhenCancelled) {
-  auto simulated = fct::test::simulateCase(smallPhantom());
+  auto simulated = fct::test::simulateCase(fct::test::smallPhantom());
   ASSERT_TRUE(simulated.ok()) << simulated.error();
   std::vector<std::string> stages;
   std::atomic<bool> cancel{false};

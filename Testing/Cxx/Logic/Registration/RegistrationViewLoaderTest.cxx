@@ -31,8 +31,9 @@ void writeImage(const fs::path& path, int cols, int rows) {
 
 /// Two views "ap" and "lat" (48 x 32 detectors); "lat" has a calibration sphere.
 std::vector<fct::ViewSpec> twoViews(const fs::path& dir) {
-  fct::ViewSpec ap{"ap", dir / "ap.png", 0, camera(48, 32, 0.0), {}, {}};
-  fct::ViewSpec lat{"lat", dir / "lat.png", 0, camera(48, 32, 1.5707963), {{{10.5, 12.0}, 3.0}}, {}};
+  fct::ViewSpec ap{"ap", dir / "ap.png", 0, camera(48, 32, 0.0), {}, {}, false, std::nullopt};
+  fct::ViewSpec lat{"lat", dir / "lat.png", 0, camera(48, 32, 1.5707963), {{{10.5, 12.0}, 3.0}}, {}, false,
+                    std::nullopt};
   return {ap, lat};
 }
 

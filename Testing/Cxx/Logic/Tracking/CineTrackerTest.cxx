@@ -6,18 +6,11 @@
 #include <random>
 
 #include "Registration/RegistrationCase.h"
-#include "Simulation/PhantomBuilder.h"
+#include "RegistrationTestCase.h"
 #include "Tracking/CineTracker.h"
 #include "TrackingTestSequence.h"
 
 namespace {
-
-fct::Volume smallPhantom() {
-  fct::PhantomOptions options;
-  options.dims = Eigen::Vector3i(80, 80, 60);
-  options.spacing_mm = 2.0;
-  return fct::PhantomBuilder::build(options).value();
-}
 
 /// A biplane 128^2 sequence of the phantom and a case prepared on its frame 0.
 struct Tracked {
@@ -27,7 +20,7 @@ struct Tracked {
 };
 
 Tracked prepare(int frames, int viewCount = 2) {
-  fct::Volume ct = smallPhantom();
+  fct::Volume ct = fct::test::smallPhantom();
   fct::test::SequenceOptions options;
   options.frames = frames;
   options.viewCount = viewCount;
