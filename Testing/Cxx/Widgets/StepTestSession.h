@@ -1,8 +1,8 @@
 #pragma once
-// A known-truth session for the step widget tests: a small phantom (or any CT) with three simulated 192x192 C-arm
-// views (RegistrationTestCase.h), loaded into a StudioDocument with its truth pose, and a shown window holding the
-// three X-ray views and the three slice views the steps attach to. Helpers click like a user (QTest) and wait for
-// the event loop.
+// A known-truth session for the step widget tests: a small phantom (or any CT) with three simulated 192x192 C-arm views
+// (RegistrationTestCase.h, which also has the phantom), loaded into a StudioDocument with its truth pose, and a shown
+// window holding the three X-ray views and the three slice views the steps attach to. Helpers click like a user (QTest)
+// and wait for the event loop.
 
 #include <gtest/gtest.h>
 
@@ -19,20 +19,11 @@
 
 #include "Image/BoneSurface.h"
 #include "Logic/RegistrationTestCase.h"
-#include "Simulation/PhantomBuilder.h"
 #include "Widgets/SliceViewWidget.h"
 #include "Widgets/StudioDocument.h"
 #include "Widgets/XrayViewWidget.h"
 
 namespace fct::test {
-
-/// The small built-in phantom (80 x 80 x 60 voxels of 2 mm) the registration tests use.
-inline Volume smallPhantom() {
-  PhantomOptions options;
-  options.dims = Eigen::Vector3i(80, 80, 60);
-  options.spacing_mm = 2.0;
-  return PhantomBuilder::build(options).value();
-}
 
 /// A document with a simulated case and the views the steps draw on.
 struct StepTestSession {
