@@ -53,12 +53,13 @@ std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage) {
 }
 
 /// The start pose as a pose vector (deg about the bone centre, mm). Fails on an empty schedule, a non-rigid
-/// `T_initial`, or DRR and X-ray not overlapping at it at the first stage's level.
+/// `T_initial`, or (with `checkOverlap`) DRR and X-ray not overlapping at it at the first stage's level.
 Result<PoseVector> checkedStartPose(const RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
-                                    const RegistrationSchedule& schedule) {
+                                    const RegistrationSchedule& schedule, bool checkOverlap) {
   if (schedule.stages.empty()) return fail(fmt::format("registration schedule '{}' has no stage", schedule.name));
   auto initialParams = RigidPose::fromTransform(T_initial, registrationCase.rotationCentre_ct_mm());
   if (!initialParams) return fail("initial pose: " + initialParams.error());
+  if (!checkOverlap) return initialParams.value().asVector();
   if (auto overlap = registrationCase.checkOverlap(T_initial, schedule.stages.front().level); !overlap) {
     return fail(overlap.error());
   }
@@ -221,7 +222,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
   RegistrationResult result;
   result.schedule = options.schedule.withAblation(options.ablation).withSeed(options.seed);
   const RegistrationSchedule& schedule = result.schedule;
-  auto start = checkedStartPose(registrationCase, T_initial, schedule);
+  auto start = checkedStartPose(registrationCase, T_initial, schedule, options.checkOverlap);
   if (!start) return fail(start.error());
 
   const ProgressMonitor monitor(ProgressMonitor::Callback{}, cancel);

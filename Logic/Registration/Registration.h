@@ -28,6 +28,9 @@ struct RegistrationOptions {
   RegistrationSchedule schedule;
   RegistrationAblation ablation;
   std::uint32_t seed = 1;  ///< seeds every stage's random search (stage i: seed + i); same seed, same result
+  /// Check that DRR and X-ray overlap at the initial pose (a whole-level DRR); off for a start known to be good, e.g.
+  /// a tracked pose.
+  bool checkOverlap = true;
 };
 
 /// A live progress report, sent after every evaluation (one DRR per view).
@@ -85,7 +88,7 @@ struct RegistrationResult {
 class Registration {
  public:
   /// Registers from `T_initial` (CT mm -> world mm). Fails, with a message naming the stage or view, on an empty
-  /// schedule, a non-rigid initial pose, DRR and X-ray not overlapping at the initial pose, a stage whose pixel set
+  /// schedule, a non-rigid initial pose, DRR and X-ray not overlapping at the initial pose (options.checkOverlap), a stage whose pixel set
   /// or metric cannot be built, or a rendering error. A cancelled run is a success with `cancelled` set.
   /// `onStageEnd` gets each stage's report (with its final pose) as the stage ends.
   static Result<RegistrationResult> run(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,

@@ -51,34 +51,12 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
     const RegistrationView& view = views[v];
     if (cancelled()) return fail(kCancelled);
     monitor.report("views", static_cast<double>(v + 1) / steps, fmt::format("preparing the X-ray of view '{}'", view.name));
-    const CameraIntrinsics& in = view.camera.intrinsics();
-    if (in.cols != view.xray.cols || in.rows != view.xray.rows) {
-      return fail(fmt::format("view '{}': the camera's detector is {}x{} pixels but the X-ray is {}x{}; fix the view "
-                              "file's detector size",
-                              view.name, in.cols, in.rows, view.xray.cols, view.xray.rows));
-    }
-    XrayImage xray = view.xray;
-    xray.camera = view.camera;
     XrayPreparationOptions preparation = options.preparation;
     preparation.spheres.insert(preparation.spheres.end(), view.spheres.begin(), view.spheres.end());
-    auto prepared = XrayPreparation(preparation).prepare(xray);
-    if (!prepared) return fail(fmt::format("view '{}': {}", view.name, prepared.error()));
-
-    // A constant X-ray (over its valid pixels) carries no information to register against.
-    const PyramidLevel& level0 = prepared.value().pyramid.level(0);
-    float lo = std::numeric_limits<float>::infinity();
-    float hi = -lo;
-    for (std::size_t i = 0; i < level0.image.pixels.size(); ++i) {
-      if (!level0.mask.valid[i]) continue;
-      lo = std::min(lo, level0.image.pixels[i]);
-      hi = std::max(hi, level0.image.pixels[i]);
-    }
-    if (!(hi > lo)) {
-      return fail(fmt::format("view '{}': the X-ray is constant ({}) over its {} valid pixels; there is nothing to "
-                              "register against (check the image file)",
-                              view.name, lo, level0.mask.validCount()));
-    }
-    result.m_views.push_back(View{view.name, view.camera, std::move(prepared).value(), {}, result.m_renderer, nullptr});
+    auto prepared = prepareXray(view.name, view.camera, view.xray, preparation);
+    if (!prepared) return fail(prepared.error());
+    result.m_views.push_back(
+        View{view.name, view.camera, std::move(preparation), std::move(prepared).value(), {}, result.m_renderer, nullptr});
   }
 
   if (cancelled()) return fail(kCancelled);
@@ -109,6 +87,45 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
                                bone.error()));
   }
   return out;
+}
+
+Result<PreparedXray> RegistrationCase::prepareXray(const std::string& name, const Camera& camera, XrayImage xray,
+                                                  const XrayPreparationOptions& preparation) {
+  const CameraIntrinsics& in = camera.intrinsics();
+  if (in.cols != xray.cols || in.rows != xray.rows) {
+    return fail(fmt::format("view '{}': the camera's detector is {}x{} pixels but the X-ray is {}x{}; fix the view "
+                            "file's detector size",
+                            name, in.cols, in.rows, xray.cols, xray.rows));
+  }
+  xray.camera = camera;
+  auto prepared = XrayPreparation(preparation).prepare(xray);
+  if (!prepared) return fail(fmt::format("view '{}': {}", name, prepared.error()));
+
+  // A constant X-ray (over its valid pixels) carries no information to register against.
+  const PyramidLevel& level0 = prepared.value().pyramid.level(0);
+  float lo = std::numeric_limits<float>::infinity();
+  float hi = -lo;
+  for (std::size_t i = 0; i < level0.image.pixels.size(); ++i) {
+    if (!level0.mask.valid[i]) continue;
+    lo = std::min(lo, level0.image.pixels[i]);
+    hi = std::max(hi, level0.image.pixels[i]);
+  }
+  if (!(hi > lo)) {
+    return fail(fmt::format("view '{}': the X-ray is constant ({}) over its {} valid pixels; there is nothing to "
+                            "register against (check the image file)",
+                            name, lo, level0.mask.validCount()));
+  }
+  return prepared;
+}
+
+Status RegistrationCase::replaceXray(std::size_t v, const XrayImage& xray) {
+  if (v >= m_views.size()) return fail(fmt::format("view index {} out of range (there are {})", v, m_views.size()));
+  View& view = m_views[v];
+  auto prepared = prepareXray(view.name, view.camera, xray, view.preparation);
+  if (!prepared) return fail(prepared.error());
+  view.prepared = std::move(prepared).value();
+  view.selectors.clear();
+  return Ok{};
 }
 
 Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expected_world_from_ct,

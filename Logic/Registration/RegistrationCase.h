@@ -101,6 +101,11 @@ class RegistrationCase {
   const std::string& viewName(std::size_t v) const { return m_views[v].name; }
   /// The prepared X-ray of view v (pyramid levels with images, masks and cameras).
   const PreparedXray& prepared(std::size_t v) const { return m_views[v].prepared; }
+  /// Swaps the X-ray of view v for a new frame of the same detector (e.g. the next frame of a cine sequence): re-runs
+  /// only that view's X-ray preparation (same options and spheres) and drops its ROI statistics; the CT, renderers,
+  /// Transgraph tables and bone surface stay. Fails, naming the view and leaving it as it was, on a bad index, an
+  /// image of another size than the view's detector, a failed preparation, or an X-ray constant over its valid pixels.
+  Status replaceXray(std::size_t v, const XrayImage& xray);
   /// The full-resolution camera of view v.
   const Camera& camera(std::size_t v) const { return m_views[v].camera; }
   /// Number of pyramid levels of every view.
@@ -137,11 +142,16 @@ class RegistrationCase {
   struct View {
     std::string name;
     Camera camera;
+    XrayPreparationOptions preparation;  ///< the case's options with the view's spheres
     PreparedXray prepared;
     std::map<std::pair<int, int>, DynamicRoiSelector> selectors;  ///< by (level, window size)
     std::shared_ptr<const DrrRenderer> renderer;                  ///< the view's renderer (see renderer(v))
     const TransgraphRenderer* transgraph = nullptr;               ///< the same renderer when it is a Transgraph
   };
+  /// Prepares `xray` for the view `name` with `camera`: the preparation, and the checks of its size and contrast.
+  /// Fails naming the view.
+  static Result<PreparedXray> prepareXray(const std::string& name, const Camera& camera, XrayImage xray,
+                                          const XrayPreparationOptions& preparation);
   /// Fails, naming the view, unless v is a view index and level one of its pyramid levels.
   Status checkViewLevel(std::size_t v, int level) const;
   /// The ROI statistics of view v at (level, window), computed on first use.

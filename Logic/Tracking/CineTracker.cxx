@@ -1,0 +1,212 @@
+#include "Tracking/CineTracker.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <utility>
+
+#include "Geometry/RigidPose.h"
+#include "Registration/RegistrationObjective.h"
+
+namespace fct {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double cpuSecondsSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
+
+/// Fails naming the option unless every tracker option is in range (the level is checked against the case).
+Status checkOptions(const CineTrackerOptions& o, int levelCount) {
+  if (o.level < 0 || o.level >= levelCount) {
+    return fail(fmt::format("tracking level {} does not exist; the case's pyramid has levels 0 to {}", o.level,
+                            levelCount - 1));
+  }
+  if (o.windowSize < 2 || o.windowSize > 64) return fail(fmt::format("tracking window must be 2..64 pixels, got {}", o.windowSize));
+  if (!(o.roiFraction > 0.0 && o.roiFraction <= 1.0)) {
+    return fail(fmt::format("tracking ROI fraction must be in (0, 1], got {}", o.roiFraction));
+  }
+  if (o.maxEvaluations <= 0) return fail(fmt::format("tracking evaluation cap must be > 0, got {}", o.maxEvaluations));
+  if (!(o.initialStep > 0.0) || !(o.tolerance > 0.0) || !(o.tolerance < o.initialStep)) {
+    return fail(fmt::format("tracking step {} and tolerance {} must be positive with the tolerance below the step",
+                            o.initialStep, o.tolerance));
+  }
+  if (!(o.similarityDrop > 0.0 && o.similarityDrop < 1.0)) {
+    return fail(fmt::format("lost-track similarity drop must be in (0, 1), got {}", o.similarityDrop));
+  }
+  if (!(o.levelWeight > 0.0 && o.levelWeight <= 1.0)) {
+    return fail(fmt::format("running-level weight must be in (0, 1], got {}", o.levelWeight));
+  }
+  if (!(o.maxJump_mm > 0.0) || !(o.maxJump_deg > 0.0)) {
+    return fail(fmt::format("lost-track jump limits must be positive, got {} mm and {} deg", o.maxJump_mm, o.maxJump_deg));
+  }
+  return Ok{};
+}
+
+/// The frame stage of the options: VLNC on dynamic ROIs at the tracking level with one local BOBYQA search.
+RegistrationStage frameStageOf(const CineTrackerOptions& o) {
+  RegistrationStage stage;
+  stage.name = fmt::format("track-vlnc-rois-level{}", o.level);
+  stage.metric = SimilarityMetric::Vlnc;
+  stage.level = o.level;
+  stage.exactDrr = o.exactDrr;
+  stage.pixels.kind = PixelSetKind::Rois;
+  stage.pixels.windowSize = o.windowSize;
+  stage.pixels.targetFraction = o.roiFraction;
+  stage.search = SearchStrategy::Local;
+  stage.maxEvaluations = o.maxEvaluations;
+  stage.simplex.method = LocalSearchMethod::Bobyqa;
+  stage.simplex.initialStep = o.initialStep;
+  stage.simplex.tolerance = o.tolerance;
+  stage.simplex.maxEvaluations = o.maxEvaluations;
+  stage.simplex.restarts = 0;
+  return stage;
+}
+
+/// The pose predicted for the next frame: `previous` moved on by the motion from `beforePrevious` to it, in pose
+/// parameters about `centre_ct_mm`; `previous` itself without a second pose.
+Eigen::Isometry3d predictedPose(const Eigen::Isometry3d& previous, const std::optional<Eigen::Isometry3d>& beforePrevious,
+                                const Eigen::Vector3d& centre_ct_mm) {
+  if (!beforePrevious) return previous;
+  auto p1 = RigidPose::fromTransform(previous, centre_ct_mm);
+  auto p0 = RigidPose::fromTransform(*beforePrevious, centre_ct_mm);
+  if (!p1 || !p0) return previous;
+  const PoseVector next = 2.0 * p1.value().asVector() - p0.value().asVector();
+  return RigidPose::toTransform(PoseParameters::fromVector(next), centre_ct_mm);
+}
+
+}  // namespace
+
+const char* CineTracker::statusName(TrackedFrameStatus status) {
+  switch (status) {
+    case TrackedFrameStatus::Tracked: return "tracked";
+    case TrackedFrameStatus::Recovered: return "recovered";
+    case TrackedFrameStatus::Lost: break;
+  }
+  return "lost";
+}
+
+CineTracker::CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options, RegistrationStage frameStage)
+    : m_case(&registrationCase), m_options(std::move(options)), m_frameStage(std::move(frameStage)) {
+  m_frameSchedule.name = "tracking";
+  m_frameSchedule.stages = {m_frameStage};
+  m_recoverySchedule.name = m_options.firstFrame.schedule.name + "-recovery";
+  for (const RegistrationStage& stage : m_options.firstFrame.schedule.stages) {
+    if (stage.search != SearchStrategy::Local) m_recoverySchedule.stages.push_back(stage);
+  }
+  m_recoverySchedule.stages.push_back(m_frameStage);
+}
+
+Result<CineTracker> CineTracker::create(RegistrationCase& registrationCase, const CineTrackerOptions& options) {
+  if (Status valid = checkOptions(options, registrationCase.levelCount()); !valid) return fail(valid.error());
+  CineTrackerOptions resolved = options;
+  if (resolved.firstFrame.schedule.stages.empty()) {
+    auto schedule = RegistrationSchedule::builtin(RegistrationSchedule::kDefaultPreset);
+    if (!schedule) return fail(schedule.error());
+    resolved.firstFrame.schedule = std::move(schedule).value();
+  }
+  RegistrationStage stage = frameStageOf(resolved);
+  return CineTracker(registrationCase, std::move(resolved), std::move(stage));
+}
+
+Status CineTracker::runSchedule(const RegistrationSchedule& schedule, const Eigen::Isometry3d& T_start,
+                                const std::atomic<bool>* cancel, TrackedFrame& frame) {
+  RegistrationOptions options = m_options.firstFrame;
+  options.schedule = schedule;
+  options.checkOverlap = false;  // the start is a tracked pose; the check would cost a whole-level DRR per frame
+  auto result = Registration::run(*m_case, T_start, options, {}, cancel);
+  if (!result) return fail(fmt::format("frame {}: {}", frame.index, result.error()));
+  const RegistrationResult& r = result.value();
+  frame.T_world_from_ct = r.T_world_from_ct;
+  frame.drrs += r.totalDrrs;
+  for (const StageReport& stage : r.stages) frame.fallbackRays += stage.fallbackRays;
+  if (!r.stages.empty()) frame.similarity = r.stages.back().similarity;
+  frame.cancelled = frame.cancelled || r.cancelled;
+  return Ok{};
+}
+
+bool CineTracker::withinBounds(const TrackedFrame& frame) const {
+  if (!(frame.similarity >= (1.0 - m_options.similarityDrop) * m_runningLevel)) return false;
+  const Eigen::Isometry3d T_delta = frame.T_predicted_world_from_ct.inverse() * frame.T_world_from_ct;
+  const Eigen::Vector3d& c = m_case->rotationCentre_ct_mm();
+  const double move_mm = (frame.T_world_from_ct * c - frame.T_predicted_world_from_ct * c).norm();
+  const double turn_deg = Eigen::AngleAxisd(T_delta.rotation()).angle() * 180.0 / M_PI;
+  return move_mm <= m_options.maxJump_mm && turn_deg <= m_options.maxJump_deg;
+}
+
+Result<TrackedFrame> CineTracker::trackFirst(const Eigen::Isometry3d& T_initial, const std::atomic<bool>* cancel) {
+  const auto start = Clock::now();
+  const std::clock_t cpuStart = std::clock();
+  TrackedFrame frame;
+  frame.index = 0;
+  frame.T_predicted_world_from_ct = T_initial;
+  auto result = Registration::run(*m_case, T_initial, m_options.firstFrame, {}, cancel);
+  if (!result) return fail("frame 0: " + result.error());
+  frame.T_world_from_ct = result.value().T_world_from_ct;
+  frame.drrs = result.value().totalDrrs;
+  frame.cancelled = result.value().cancelled;
+  // The running level starts at the frame stage's similarity at the registered pose (the stage's own metric).
+  auto objective = RegistrationObjective::create(*m_case, m_frameStage, !m_frameStage.exactDrr,
+                                                 frame.T_world_from_ct, frame.T_world_from_ct);
+  if (!objective) return fail("frame 0: " + objective.error());
+  auto similarity = objective.value().similarity(frame.T_world_from_ct);
+  if (!similarity) return fail("frame 0: " + similarity.error());
+  frame.drrs += objective.value().drrCount();
+  frame.similarity = similarity.value();
+  m_runningLevel = frame.runningLevel = frame.similarity;
+  m_T_previous = frame.T_world_from_ct;
+  m_T_beforePrevious.reset();
+  m_nextIndex = 1;
+  frame.seconds = secondsSince(start);
+  frame.cpuSeconds = cpuSecondsSince(cpuStart);
+  return frame;
+}
+
+Result<TrackedFrame> CineTracker::trackNext(const std::vector<XrayImage>& frameImages, const std::atomic<bool>* cancel) {
+  if (!m_T_previous) return fail("tracking: register the first frame (trackFirst) before the next ones");
+  if (frameImages.size() != m_case->viewCount()) {
+    return fail(fmt::format("frame {}: {} images given for {} views; give one image per view", m_nextIndex,
+                            frameImages.size(), m_case->viewCount()));
+  }
+  const auto start = Clock::now();
+  const std::clock_t cpuStart = std::clock();
+  TrackedFrame frame;
+  frame.index = m_nextIndex;
+  for (std::size_t v = 0; v < frameImages.size(); ++v) {
+    if (Status swapped = m_case->replaceXray(v, frameImages[v]); !swapped) {
+      return fail(fmt::format("frame {}: {}", frame.index, swapped.error()));
+    }
+  }
+  frame.swapSeconds = secondsSince(start);
+  frame.runningLevel = m_runningLevel;
+  const Eigen::Vector3d& centre = m_case->rotationCentre_ct_mm();
+  frame.T_predicted_world_from_ct =
+      m_options.constantVelocity ? predictedPose(*m_T_previous, m_T_beforePrevious, centre) : *m_T_previous;
+
+  if (Status run = runSchedule(m_frameSchedule, frame.T_predicted_world_from_ct, cancel, frame); !run) return fail(run.error());
+  if (!frame.cancelled && !withinBounds(frame)) {
+    if (Status run = runSchedule(m_recoverySchedule, frame.T_predicted_world_from_ct, cancel, frame); !run) {
+      return fail(run.error());
+    }
+    frame.status = withinBounds(frame) ? TrackedFrameStatus::Recovered : TrackedFrameStatus::Lost;
+  }
+  if (!frame.cancelled) {
+    if (frame.status == TrackedFrameStatus::Lost) {
+      m_T_beforePrevious.reset();  // keep the last trusted pose, drop the velocity
+    } else {
+      m_T_beforePrevious = m_T_previous;
+      m_T_previous = frame.T_world_from_ct;
+      m_runningLevel = (1.0 - m_options.levelWeight) * m_runningLevel + m_options.levelWeight * frame.similarity;
+    }
+  }
+  ++m_nextIndex;
+  frame.seconds = secondsSince(start);
+  frame.cpuSeconds = cpuSecondsSince(cpuStart);
+  return frame;
+}
+
+}  // namespace fct

@@ -1,0 +1,114 @@
+#pragma once
+// CineTracker: follows the bone through a fluoroscopy sequence frame by frame on one RegistrationCase (CT, renderers,
+// Transgraph tables and bone surface prepared once, on frame 0's images). Frame 0 is registered with a full schedule
+// (the default preset). Every later frame swaps each view's X-ray for the new frame (RegistrationCase::replaceXray),
+// starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre)
+// and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
+// run by Registration with RegistrationObjective). A frame whose similarity falls below (1 - similarityDrop) times the
+// running level, or whose pose differs from the prediction by more than the jump limits, is re-registered from the
+// prediction with the global stage(s) of the first-frame schedule followed by the frame stage: it is `Recovered` when
+// that restores the level (and the jump limits hold), else `Lost` (the next frame then starts from the last trusted
+// pose without velocity).
+
+#include <Eigen/Geometry>
+
+#include <atomic>
+#include <optional>
+#include <vector>
+
+#include "Base/Result.h"
+#include "Drr/DrrRenderer.h"
+#include "Image/XrayImage.h"
+#include "Registration/Registration.h"
+#include "Registration/RegistrationCase.h"
+#include "Registration/RegistrationSchedule.h"
+
+namespace fct {
+
+/// How a frame's pose was obtained.
+enum class TrackedFrameStatus {
+  Tracked,    ///< the frame stage from the prediction met the lost-track rule's bounds
+  Recovered,  ///< the frame stage did not; the global re-registration restored the similarity level
+  Lost,       ///< neither did: the pose is the re-registration's best, not trusted for the next prediction
+};
+
+/// One tracked frame.
+struct TrackedFrame {
+  int index = 0;                                                     ///< frame index, 0 = the first frame
+  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the frame's pose (CT mm -> world mm, LPS)
+  Eigen::Isometry3d T_predicted_world_from_ct = Eigen::Isometry3d::Identity();  ///< the search's start pose
+  double similarity = 0.0;   ///< frame-stage similarity (VLNC over the frame's ROIs, mean over views) at the pose
+  double runningLevel = 0.0; ///< the running similarity level the frame was judged against (after frame 0)
+  double seconds = 0.0;      ///< wall time of the frame: X-ray swap, search and any recovery
+  double cpuSeconds = 0.0;   ///< process CPU time (every thread) of the same
+  double swapSeconds = 0.0;  ///< wall time of the X-ray swap alone (RegistrationCase::replaceXray of every view)
+  long drrs = 0;             ///< DRRs rendered for the frame (evaluations x views)
+  long fallbackRays = 0;     ///< Transgraph rays outside their tables, integrated exactly
+  TrackedFrameStatus status = TrackedFrameStatus::Tracked;
+  bool cancelled = false;    ///< the cancel flag stopped the frame; the pose is the best so far
+};
+
+/// Settings of the tracker. Scaled units as LocalSearchOptions (about 1 mm of bone-surface motion).
+struct CineTrackerOptions {
+  /// Frame 0's registration; an empty schedule means the default preset (RegistrationSchedule::kDefaultPreset).
+  RegistrationOptions firstFrame;
+  int level = 1;                  ///< pyramid level of the frame stage (0 = full resolution, 1 = 1:4 pixels)
+  int windowSize = 7;             ///< VLNC window, pixels of that level
+  double roiFraction = 0.06;      ///< dynamic ROIs: fraction of the valid pixels compared (0 < f <= 1)
+  int maxEvaluations = 60;        ///< cap on DRR sets of the frame stage
+  double initialStep = 0.5;       ///< BOBYQA's first trust radius, scaled units
+  double tolerance = 0.05;        ///< BOBYQA's stopping step, scaled units
+  /// Render the frame stage with the case's exact renderer (Siddon on the CT coarsened to the level) even when the
+  /// case has Transgraph tables; false uses the tables (built once around frame 0's initial pose).
+  bool exactDrr = false;
+  bool constantVelocity = true;   ///< predict previous pose + last inter-frame motion (false: previous pose)
+  double similarityDrop = 0.25;   ///< lost when similarity < (1 - similarityDrop) * running level, 0 < d < 1
+  double levelWeight = 0.2;       ///< weight of a new tracked frame in the running level (exponential mean), 0 < w <= 1
+  double maxJump_mm = 8.0;        ///< lost when the rotation centre moves more than this from the prediction, mm
+  double maxJump_deg = 6.0;       ///< lost when the rotation differs more than this from the prediction, deg
+};
+
+/// Tracks the bone through a sequence, frame by frame.
+class CineTracker {
+ public:
+  /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
+  /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
+  /// outside (0, 1], a non-positive cap, step or tolerance, a drop outside (0, 1), a level weight outside (0, 1], a
+  /// non-positive jump limit, or an unknown first-frame preset.
+  static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
+
+  /// Registers frame 0 (the case's current images) with the first-frame schedule from T_initial and sets the running
+  /// similarity level. Fails as Registration::run; a cancelled run is a success with `cancelled` set.
+  Result<TrackedFrame> trackFirst(const Eigen::Isometry3d& T_initial, const std::atomic<bool>* cancel = nullptr);
+  /// Tracks the next frame: one image per view, in the case's view order and of each view's detector size. Fails
+  /// before trackFirst, on a wrong image count or size, an X-ray the preparation rejects (naming the view), or a
+  /// rendering error. A cancelled frame is a success with `cancelled` set.
+  Result<TrackedFrame> trackNext(const std::vector<XrayImage>& frameImages, const std::atomic<bool>* cancel = nullptr);
+
+  /// The frame stage (VLNC on ROIs at the tracker's level, local BOBYQA), as run on every frame after the first.
+  const RegistrationStage& frameStage() const { return m_frameStage; }
+  /// The options the tracker runs with (the first-frame schedule resolved).
+  const CineTrackerOptions& options() const { return m_options; }
+  /// Lowercase name of a status ("tracked", "recovered", "lost").
+  static const char* statusName(TrackedFrameStatus status);
+
+ private:
+  CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options, RegistrationStage frameStage);
+  /// Runs `schedule` from T_start and folds its result into `frame` (pose, similarity, DRRs, cancelled).
+  Status runSchedule(const RegistrationSchedule& schedule, const Eigen::Isometry3d& T_start,
+                     const std::atomic<bool>* cancel, TrackedFrame& frame);
+  /// True when `frame` passes the lost-track rule against the running level and its prediction.
+  bool withinBounds(const TrackedFrame& frame) const;
+
+  RegistrationCase* m_case;
+  CineTrackerOptions m_options;
+  RegistrationStage m_frameStage;
+  RegistrationSchedule m_frameSchedule;     ///< the frame stage alone
+  RegistrationSchedule m_recoverySchedule;  ///< the first-frame schedule's global stages, then the frame stage
+  int m_nextIndex = 0;
+  double m_runningLevel = 0.0;
+  std::optional<Eigen::Isometry3d> m_T_previous;       ///< last trusted pose
+  std::optional<Eigen::Isometry3d> m_T_beforePrevious; ///< the trusted pose before it, for the velocity
+};
+
+}  // namespace fct
