@@ -25,6 +25,9 @@
 #include "Evaluation/StudyRunner.h"
 #include "Evaluation/StudySetupFile.h"
 #include "Evaluation/StudyShard.h"
+#include "Evaluation/TrackingFrameStore.h"
+#include "Evaluation/TrackingReport.h"
+#include "Evaluation/TrackingStudy.h"
 #include "Evaluation/TrialStore.h"
 #include "IO/Volume/CtLoader.h"
 #include "Registration/RegistrationSchedule.h"
@@ -127,7 +130,7 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o) {
                               o.study));
     }
     paths.emplace_back("pelvis", data / "ct/pelvis_totalseg.nii.gz");
-    if (o.study == "table2") paths.emplace_back("head", data / "ct/head_phantom_philips_bone");
+    if (o.study == "table2" || o.study == "tracking") paths.emplace_back("head", data / "ct/head_phantom_philips_bone");
     for (const auto& [label, path] : paths) {
       if (!fs::exists(path)) {
         return fail(fmt::format("the full '{}' study needs {}, which does not exist; set FLUOROCT_DATA_DIR to the data "
@@ -277,7 +280,83 @@ int runMerge(const EvaluateOptions& o, const StudyDefinition& known) {
   return 0;
 }
 
+/// The resume check of a tracking study: the options that change its results, one per line.
+std::string trackingSetupText(const EvaluateOptions& o, const TrackingStudyDefinition& study) {
+  return fmt::format("study: tracking\nquick: {}\ncts: {}\npreset: {}\nsequences: {}\nframes: {}\nseed: {}\n",
+                     o.quick, fmt::join(o.cts, " "), study.preset, o.trials, study.motion.frames, study.seed);
+}
+
+/// --study tracking: simulates and tracks the sequences (TrackingStudy) into DIR/frames.json (resumable) and
+/// DIR/frames.csv, then writes DIR/report.md and DIR/summary.csv (TrackingReport).
+int runTrackingStudy(const EvaluateOptions& o) {
+  if (!o.shard.empty() || !o.merge.empty() || !o.detector.empty() || o.pixel_mm != 0.0 || o.method != "siddon" ||
+      o.jobs != 1) {
+    return reportError("the tracking study fixes its detectors and runs its sequences one after another: drop "
+                       "--shard, --merge, --detector, --pixel-mm, --method and --jobs");
+  }
+  if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
+  auto checked = TrackingStudy::define(o.quick, {"ct"});
+  if (!checked) return reportError(checked.error());
+  if (!o.preset.empty()) checked.value().preset = o.preset;
+  if (auto settings = TrackingStudy::trackerOptions(checked.value()); !settings) {
+    return reportError("--preset: " + settings.error());
+  }
+  if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
+  auto store = TrackingFrameStore::open(o.out);
+  if (!store) return reportError("--out: " + store.error());
+  auto cts = loadCts(o);
+  if (!cts) return reportError(cts.error());
+  std::vector<std::string> labels;
+  for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
+  TrackingStudyDefinition study = TrackingStudy::define(o.quick, labels).value();
+  if (!o.preset.empty()) study.preset = o.preset;
+  for (TrackingCondition& c : study.conditions) {
+    if (o.trials > 0) c.sequences = o.trials;
+  }
+  if (Status same = StudySetupFile::checkOrWrite(o.out, trackingSetupText(o, study), !store.value().records().empty());
+      !same) {
+    return reportError("--out: " + same.error());
+  }
+  fmt::print(stderr, "evaluate: study 'tracking'{} on {}: {} conditions, {} frames per sequence; frame 0 preset {}\n",
+             o.quick ? " (quick)" : "", fmt::join(labels, ", "), study.conditions.size(), study.motion.frames,
+             study.preset);
+  TrackingRunOptions run;
+  run.cancel = InterruptGuard::cancelFlag();
+  run.onMessage = [](const std::string& text) { fmt::print(stderr, "evaluate: {}\n", text); };
+  run.onSequence = [&study](const TrackingProgress& progress) {
+    const TrackingFrameRecord& first = progress.frames.front();
+    const auto condition = std::find_if(study.conditions.begin(), study.conditions.end(),
+                                        [&](const TrackingCondition& c) { return c.name == first.condition; });
+    const TrackingConditionStats s = TrackingReport::statistics(*condition, progress.frames);
+    fmt::print(stderr, "[{}/{}] {} sequence {}: {} frames, median sTRE {:.3f} mm (max {:.3f}), {} failures, {} "
+                       "recovered, {:.1f} frames/s\n",
+               progress.finished, progress.toRun, first.condition, first.sequence, s.frames, s.medianStre_mm,
+               s.maxStre_mm, s.failures, s.recoveries, s.framesPerSecond);
+  };
+  auto summary = [&] {
+    const InterruptGuard interrupt;  // Ctrl-C stops the running sequence (the finished ones stay saved)
+    return TrackingStudy::run(study, cts.value(), store.value(), run);
+  }();
+  if (!summary) return reportError(summary.error());
+  std::vector<std::string> notes = TrackingStudy::notes(study);
+  notes.insert(notes.begin(), fmt::format("command: `fluoroct evaluate --study tracking{} --out {}{}{}{}`",
+                                          o.quick ? " --quick" : "", o.out,
+                                          o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
+                                          o.cts.empty() ? "" : fmt::format(" --ct {}", fmt::join(o.cts, " ")),
+                                          o.preset.empty() ? "" : " --preset " + o.preset));
+  auto written = TrackingReport::write(study, store.value().records(), notes, o.out);
+  if (!written) return reportError(written.error());
+  fmt::print("tracking: ran {} sequences, skipped {} already done; wrote {}, {}, {} and {}\n", summary.value().ran,
+             summary.value().skipped, (fs::path(o.out) / "frames.json").string(),
+             (fs::path(o.out) / "frames.csv").string(), written.value()[0].string(), written.value()[1].string());
+  if (summary.value().cancelled) {
+    return reportError("cancelled; the finished sequences are saved: re-run the same command to resume");
+  }
+  return 0;
+}
+
 int runEvaluate(const EvaluateOptions& o) {
+  if (o.study == "tracking") return runTrackingStudy(o);
   auto known = checkOptions(o);
   if (!known) return reportError(known.error());
   if (!o.merge.empty()) return runMerge(o, known.value());
@@ -334,15 +413,19 @@ int runEvaluate(const EvaluateOptions& o) {
 void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
   auto options = std::make_shared<EvaluateOptions>();
   CLI::App* command = app.add_subcommand(
-      "evaluate", "Run an evaluation study (table2, capture, ablation, views) on simulated X-rays of known truth; "
-                  "writes DIR/trials.csv (resumable), DIR/report.md and PNG charts");
-  command->add_option("--study", options->study, "Study: table2, capture, ablation or views")->required();
+      "evaluate", "Run an evaluation study (table2, capture, ablation, views, tracking) on simulated X-rays of known "
+                  "truth; writes DIR/trials.csv (tracking: DIR/frames.csv; resumable), DIR/report.md and PNG charts");
+  command->add_option("--study", options->study,
+                      "Study: table2, capture, ablation, views or tracking (simulated cine sequences of a moving bone, "
+                      "single-plane and biplane, tracked frame by frame)")
+      ->required();
   command->add_option("--out", options->out, "Output folder (re-running with the same folder resumes)")->required();
   command->add_flag("--quick", options->quick,
                     "Small version on the built-in phantom (fast preset, 128x128 detector, 2 trials per condition)");
   command->add_option("--jobs", options->jobs, "Trials run in parallel")->capture_default_str();
   command->add_option("--trials", options->trials,
-                      "At most this many trials per condition (a sample of a study; the first N of each condition)");
+                      "At most this many trials per condition (a sample of a study; the first N of each condition); "
+                      "tracking: this many sequences per condition");
   command->add_option("--ct", options->cts,
                       "CT volume(s) or DICOM folder(s) instead of the defaults (full: the pelvis of $FLUOROCT_DATA_DIR, "
                       "plus its head phantom for table2; quick: the phantom)");

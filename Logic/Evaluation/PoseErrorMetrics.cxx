@@ -1,5 +1,6 @@
 #include "Evaluation/PoseErrorMetrics.h"
 
+#include <cmath>
 
 namespace fct {
 
@@ -40,6 +41,24 @@ PoseError PoseErrorMetrics::measure(const Eigen::Isometry3d& T_estimate, const E
   error.rotation_deg = Eigen::AngleAxisd(residual).angle() * 180.0 / EIGEN_PI;
   const Eigen::Vector3d centre_ct_mm = m_surface.centroid_ct_mm();
   error.translation_mm = (T_estimate * centre_ct_mm - T_truth * centre_ct_mm).norm();
+  return error;
+}
+
+ViewPlaneError PoseErrorMetrics::measureInView(const Eigen::Isometry3d& T_estimate, const Eigen::Isometry3d& T_truth,
+                                              const Eigen::Vector3d& source_world_mm) const {
+  const Eigen::Vector3d ray = T_truth * m_surface.centroid_ct_mm() - source_world_mm;
+  const double rayLength_mm = ray.norm();
+  const Eigen::Vector3d u = rayLength_mm > 0.0 ? Eigen::Vector3d(ray / rayLength_mm) : Eigen::Vector3d::Zero();
+  ViewPlaneError error;
+  for (const Eigen::Vector3d& p : m_surface.points_ct_mm()) {
+    const Eigen::Vector3d d = T_estimate * p - T_truth * p;
+    const double along_mm = d.dot(u);
+    error.outOfPlaneMean_mm += std::abs(along_mm);
+    error.inPlaneMean_mm += (d - along_mm * u).norm();
+  }
+  const double count = static_cast<double>(m_surface.points_ct_mm().size());
+  error.inPlaneMean_mm /= count;
+  error.outOfPlaneMean_mm /= count;
   return error;
 }
 

@@ -6,6 +6,9 @@
 //   box (CT frame) of those surface points, i.e. a volume region around the bone, not only its surface.
 // - rotation error: the angle of R_est * R_true^T in degrees (0..180).
 // - translation error: |T_est c - T_true c| in mm at the bone centre c (the surface points' centroid).
+// - single-plane components: each surface point's displacement split along the viewing ray from the X-ray source
+//   through the bone centre's true position (out-of-plane: the depth one view hardly sees) and across it (in-plane),
+//   each averaged over the points.
 // Success is sTRE mean < 2 mm (the paper's definition); the capture range is read off per-bin success rates.
 
 #include <Eigen/Geometry>
@@ -25,6 +28,12 @@ struct PoseError {
   double mtre_mm = 0.0;         ///< mean distance over the grid of the bone's bounding box
   double rotation_deg = 0.0;    ///< angle of the residual rotation R_est * R_true^T
   double translation_mm = 0.0;  ///< distance of the bone centre's two images
+};
+
+/// The error of one estimated pose as one view sees it (mm): across and along the viewing ray of the bone centre.
+struct ViewPlaneError {
+  double inPlaneMean_mm = 0.0;     ///< mean length of the displacements' parts across the ray (seen by the view)
+  double outOfPlaneMean_mm = 0.0;  ///< mean length of their parts along the ray (depth)
 };
 
 /// Success rate of the trials whose initial sTRE falls in one bin [low_mm, high_mm).
@@ -54,6 +63,12 @@ class PoseErrorMetrics {
   /// The error of T_estimate against T_truth (both T_world_from_ct, LPS mm). Identical poses give all zeros; a pure
   /// translation by d mm gives d for both sTREs, the mTRE and the translation, and 0 deg.
   PoseError measure(const Eigen::Isometry3d& T_estimate, const Eigen::Isometry3d& T_truth) const;
+  /// The sTRE points' displacements T_estimate p - T_truth p split along and across the unit ray from
+  /// `source_world_mm` (the view's X-ray source, world LPS mm) through the true bone centre T_truth c. A shift along
+  /// that ray is all out-of-plane, one perpendicular to it all in-plane. A source at the bone centre gives the whole
+  /// sTRE as in-plane.
+  ViewPlaneError measureInView(const Eigen::Isometry3d& T_estimate, const Eigen::Isometry3d& T_truth,
+                               const Eigen::Vector3d& source_world_mm) const;
   /// True when the error counts as a successful registration (sTRE mean < kSuccessThreshold_mm).
   static bool isSuccess(const PoseError& error) { return error.streMean_mm < kSuccessThreshold_mm; }
   /// Capture range in mm: the upper edge of the last bin of the longest run of bins, from the first one, whose

@@ -40,6 +40,20 @@ std::string StudyXraySource::description() {
                      o.photonsPerPixel, o.psfSigma_px, o.vignetting, o.kwireCount, o.screwCount);
 }
 
+namespace {
+
+/// A simulated detector image as the X-ray registration reads.
+XrayImage toXray(FloatImage image) {
+  XrayImage xray;
+  xray.cols = image.cols;
+  xray.rows = image.rows;
+  xray.modality = "simulated";
+  xray.pixels = std::move(image.pixels);
+  return xray;
+}
+
+}  // namespace
+
 Result<std::vector<RegistrationView>> StudyXraySource::simulate(const Volume& ct, const std::vector<ViewSpec>& views,
                                                                 const Eigen::Isometry3d& T_world_from_ct,
                                                                 std::uint32_t seed, bool foreignObjects) {
@@ -51,14 +65,25 @@ Result<std::vector<RegistrationView>> StudyXraySource::simulate(const Volume& ct
     auto image = FluoroscopySimulator::render(ct, spec.camera, T_world_from_ct, options,
                                               seed + static_cast<std::uint32_t>(v));
     if (!image) return fail(fmt::format("view '{}': {}", spec.name, image.error()));
-    XrayImage xray;
-    xray.cols = image.value().cols;
-    xray.rows = image.value().rows;
-    xray.modality = "simulated";
-    xray.pixels = std::move(image.value().pixels);
-    out.push_back(RegistrationView{spec.name, std::move(xray), spec.camera, {}});
+    out.push_back(RegistrationView{spec.name, toXray(std::move(image).value()), spec.camera, {}});
   }
   return out;
+}
+
+Status StudyXraySource::simulateSequence(const Volume& ct, const std::vector<ViewSpec>& views,
+                                         const std::vector<Eigen::Isometry3d>& poses_world_from_ct, std::uint32_t seed,
+                                         bool foreignObjects, const FrameSink& onFrame) {
+  FluoroscopyOptions options = forwardModel(foreignObjects);
+  options.seed = seed;
+  std::vector<Camera> cameras;
+  for (const ViewSpec& spec : views) cameras.push_back(spec.camera);
+  return FluoroscopySimulator::renderSequence(
+      ct, cameras, poses_world_from_ct, options, seed, foreignObjects,
+      [&](int frame, std::vector<FloatImage> images) -> Status {
+        std::vector<XrayImage> xrays;
+        for (FloatImage& image : images) xrays.push_back(toXray(std::move(image)));
+        return onFrame(frame, std::move(xrays));
+      });
 }
 
 Result<Volume> StudyXraySource::registrationCt(const Volume& ct, double sliceSpacing_mm) {

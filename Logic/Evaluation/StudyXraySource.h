@@ -8,11 +8,13 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "Base/Result.h"
 #include "Image/Volume.h"
+#include "Image/XrayImage.h"
 #include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationView.h"
 #include "Simulation/FluoroscopySimulator.h"
@@ -33,6 +35,15 @@ class StudyXraySource {
   static Result<std::vector<RegistrationView>> simulate(const Volume& ct, const std::vector<ViewSpec>& views,
                                                         const Eigen::Isometry3d& T_world_from_ct, std::uint32_t seed,
                                                         bool foreignObjects);
+  /// Receives frame `frame`'s X-rays (one per view, in view order); an error stops simulateSequence with it.
+  using FrameSink = std::function<Status(int frame, std::vector<XrayImage> xrays)>;
+  /// A cine sequence of `ct` (LPS mm): frame k's X-rays of every view at poses_world_from_ct[k], each frame and view
+  /// with its own noise (seeds from `seed`), passed to `onFrame` as each frame is rendered; with `foreignObjects`,
+  /// K-wires and screws placed at the first pose that stay fixed in the world while the bone moves. Fails, naming
+  /// frame and view, on a simulation error, or with the first error of `onFrame`.
+  static Status simulateSequence(const Volume& ct, const std::vector<ViewSpec>& views,
+                                 const std::vector<Eigen::Isometry3d>& poses_world_from_ct, std::uint32_t seed,
+                                 bool foreignObjects, const FrameSink& onFrame);
   /// The CT registration sees: `ct` resampled to `sliceSpacing_mm` along its slice axis with the matching
   /// slice-thickness blur (CtSliceDegrader), or `ct` itself when effectiveSliceSpacing_mm() is 0. Fails on a negative
   /// or non-finite spacing or a resampling error.

@@ -141,19 +141,24 @@ struct ViewGeometry {
   Eigen::Matrix3d R_ct_from_camera;
   Eigen::Vector2d centre_px;
   double collimator_px = 0.0;
+  Eigen::Vector3d source_implants;         ///< the source in the implants' frame (the CT frame where they were
+  Eigen::Matrix3d R_implants_from_camera;  ///< placed, at their own world pose)
 };
 
-/// The ray geometry of `camera` with the CT at T_world_from_ct.
+/// The ray geometry of `camera` with the CT at T_world_from_ct and the implants at T_world_from_implants.
 ViewGeometry viewGeometry(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
-                          const FluoroscopyOptions& options) {
+                          const Eigen::Isometry3d& T_world_from_implants, const FluoroscopyOptions& options) {
   const CameraIntrinsics& in = camera.intrinsics();
   const Eigen::Isometry3d T_ct_from_camera = T_world_from_ct.inverse() * camera.T_world_from_camera();
+  const Eigen::Isometry3d T_implants_from_camera = T_world_from_implants.inverse() * camera.T_world_from_camera();
   return {in,
           camera.K(),
           T_ct_from_camera.translation(),
           T_ct_from_camera.linear(),
           Eigen::Vector2d(0.5 * (in.cols - 1), 0.5 * (in.rows - 1)),
-          options.collimatorRadiusFraction * 0.5 * std::min(in.cols, in.rows)};
+          options.collimatorRadiusFraction * 0.5 * std::min(in.cols, in.rows),
+          T_implants_from_camera.translation(),
+          T_implants_from_camera.linear()};
 }
 
 /// The spectrum bins' photon fractions and energy weights (photon fraction × keV) with the weights' sum.
@@ -238,7 +243,7 @@ LineIntegrals traceLineIntegrals(const Scene& scene, const ViewGeometry& g, cons
       MassPaths& paths = rays.pixelPaths[index];
       if (patient) {
         paths = scene.trace(g.source_ct, direction_ct);
-        scene.implants.accumulate(g.source_ct, direction_ct, paths);
+        scene.implants.accumulate(g.source_implants, g.R_implants_from_camera * direction_camera, paths);
       }
       spheres.accumulate(Eigen::Vector3d::Zero(), direction_camera, paths);
       for (double& path : paths) path = std::max(0.0, path);  // a gas pocket removes at most the tissue there
@@ -380,13 +385,15 @@ std::vector<PixelCircle> sphereShadows(const ForeignObjectSet& spheres, const Vi
   return shadows;
 }
 
-/// Renders one view of a prepared scene; the pose must already be checked rigid. Fails on an empty detector, bad
-/// distortion, sphere or plate settings, a collimator or pose that lets no X-ray through, or an image-processing
-/// error.
+/// Renders one view of a prepared scene; the pose must already be checked rigid. The implants move with the bone,
+/// or stay at T_world_from_implants when one is given. Fails on an empty detector, bad distortion, sphere or plate
+/// settings, a collimator or pose that lets no X-ray through, or an image-processing error.
 Result<RenderedView> renderView(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
                                 const FluoroscopyOptions& options, std::uint32_t viewSeed,
-                                ViewContent content = ViewContent::Patient) {
-  const ViewGeometry geometry = viewGeometry(camera, T_world_from_ct, options);
+                                ViewContent content = ViewContent::Patient,
+                                const Eigen::Isometry3d* T_world_from_implants = nullptr) {
+  const ViewGeometry geometry =
+      viewGeometry(camera, T_world_from_ct, T_world_from_implants ? *T_world_from_implants : T_world_from_ct, options);
   if (geometry.in.cols <= 0 || geometry.in.rows <= 0) return fail("camera has an empty detector; check the view file");
   auto distortion = distortionFor(geometry.in, options);
   if (!distortion.ok()) return fail(distortion.error());
@@ -478,6 +485,32 @@ Result<std::vector<FloatImage>> FluoroscopySimulator::renderViews(const Volume& 
     images.push_back(std::move(view.value().image));
   }
   return images;
+}
+
+Status FluoroscopySimulator::renderSequence(const Volume& ct, const std::vector<Camera>& cameras,
+                                            const std::vector<Eigen::Isometry3d>& poses_world_from_ct,
+                                            const FluoroscopyOptions& options, std::uint32_t firstSeed,
+                                            bool implantsFixedInWorld, const SequenceFrameSink& onFrame) {
+  if (poses_world_from_ct.empty()) return fail("a sequence needs at least one pose");
+  for (std::size_t k = 0; k < poses_world_from_ct.size(); ++k) {
+    if (Status rigid = checkRigid(poses_world_from_ct[k]); !rigid) return fail(fmt::format("frame {}: {}", k, rigid.error()));
+  }
+  auto scene = prepareScene(&ct, options);
+  if (!scene.ok()) return fail(scene.error());
+  const Eigen::Isometry3d T_world_from_implants = poses_world_from_ct.front();
+  const std::uint32_t viewCount = static_cast<std::uint32_t>(cameras.size());
+  for (std::size_t k = 0; k < poses_world_from_ct.size(); ++k) {
+    std::vector<FloatImage> images;
+    for (std::uint32_t n = 0; n < viewCount; ++n) {
+      auto view = renderView(scene.value(), cameras[n], poses_world_from_ct[k], options,
+                             firstSeed + static_cast<std::uint32_t>(k) * viewCount + n, ViewContent::Patient,
+                             implantsFixedInWorld ? &T_world_from_implants : nullptr);
+      if (!view.ok()) return fail(fmt::format("frame {}, view {}: {}", k, n, view.error()));
+      images.push_back(std::move(view.value().image));
+    }
+    if (Status taken = onFrame(static_cast<int>(k), std::move(images)); !taken) return taken;
+  }
+  return Ok{};
 }
 
 Result<FloatImage> FluoroscopySimulator::renderGridPlate(const Camera& camera, const FluoroscopyOptions& options,

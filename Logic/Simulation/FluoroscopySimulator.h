@@ -22,6 +22,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,19 @@ class FluoroscopySimulator {
   static Result<std::vector<FloatImage>> renderViews(const Volume& ct, const std::vector<Camera>& cameras,
                                                      const Eigen::Isometry3d& T_world_from_ct,
                                                      const FluoroscopyOptions& options, std::uint32_t firstViewSeed);
+
+  /// Receives frame `frame`'s images (one per camera); an error stops renderSequence with it.
+  using SequenceFrameSink = std::function<Status(int frame, std::vector<FloatImage> images)>;
+
+  /// A sequence: render() of every camera at each pose (frame k, view n with noise seed firstSeed + k * cameras + n),
+  /// preparing the patient and the objects (placed by options.seed) once, and passing each frame to `onFrame` as soon
+  /// as it is rendered. The objects move with the bone, or with `implantsFixedInWorld` stay where they are at the
+  /// first pose (tools held still while the bone moves). Fails as render() does (naming frame and view), on no
+  /// pose, or with the first error of `onFrame`.
+  static Status renderSequence(const Volume& ct, const std::vector<Camera>& cameras,
+                               const std::vector<Eigen::Isometry3d>& poses_world_from_ct,
+                               const FluoroscopyOptions& options, std::uint32_t firstSeed, bool implantsFixedInWorld,
+                               const SequenceFrameSink& onFrame);
 
   /// Image of the dewarp calibration plate alone (no patient, no calibration spheres; beads of
   /// options.gridBeadRadius_mm at options.gridPitch_mm, centred on the principal ray) seen by `camera` through the

@@ -85,3 +85,37 @@ TEST(PoseErrorMetrics, CtWithoutBoneIsRejectedWithItsValueRange) {
   ASSERT_FALSE(metrics.ok());
   EXPECT_NE(metrics.error().find("bone threshold"), std::string::npos) << metrics.error();
 }
+
+TEST(PoseErrorMetrics, DepthShiftAlongTheViewingRayIsAllOutOfPlane) {
+  const auto metrics = fct::PoseErrorMetrics::create(boneBlock()).value();
+  const Eigen::Vector3d centre_world_mm = somePose() * metrics.surface().centroid_ct_mm();
+  const Eigen::Vector3d source_world_mm = centre_world_mm + Eigen::Vector3d(100.0, -600.0, 200.0);
+  const Eigen::Vector3d ray = (centre_world_mm - source_world_mm).normalized();
+  Eigen::Isometry3d T_estimate = somePose();
+  T_estimate.pretranslate(3.0 * ray);
+  const fct::ViewPlaneError e = metrics.measureInView(T_estimate, somePose(), source_world_mm);
+  EXPECT_NEAR(e.outOfPlaneMean_mm, 3.0, 1e-9);
+  EXPECT_NEAR(e.inPlaneMean_mm, 0.0, 1e-9);
+}
+
+TEST(PoseErrorMetrics, DetectorParallelShiftIsAllInPlaneAndRotationSplitsBetweenBoth) {
+  const auto metrics = fct::PoseErrorMetrics::create(boneBlock()).value();
+  const Eigen::Vector3d centre_world_mm = somePose() * metrics.surface().centroid_ct_mm();
+  const Eigen::Vector3d source_world_mm = centre_world_mm - Eigen::Vector3d(0.0, 0.0, 700.0);  // looking along +z
+  Eigen::Isometry3d shifted = somePose();
+  shifted.pretranslate(Eigen::Vector3d(1.2, -1.6, 0.0));  // 2 mm across the ray
+  const fct::ViewPlaneError across = metrics.measureInView(shifted, somePose(), source_world_mm);
+  EXPECT_NEAR(across.inPlaneMean_mm, 2.0, 1e-9);
+  EXPECT_NEAR(across.outOfPlaneMean_mm, 0.0, 1e-9);
+
+  // A rotation about the ray's own axis through the centre moves the points only across the ray.
+  Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
+  turned.linear() = Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  turned.translation() = centre_world_mm - turned.linear() * centre_world_mm;
+  const fct::ViewPlaneError spun = metrics.measureInView(turned * somePose(), somePose(), source_world_mm);
+  EXPECT_GT(spun.inPlaneMean_mm, 0.1);
+  EXPECT_NEAR(spun.outOfPlaneMean_mm, 0.0, 1e-9);
+  // The in-plane part never exceeds the whole sTRE.
+  const fct::PoseError whole = metrics.measure(turned * somePose(), somePose());
+  EXPECT_LE(spun.inPlaneMean_mm, whole.streMean_mm + 1e-9);
+}

@@ -349,3 +349,71 @@ TEST(FluoroscopySimulator, RejectsBadInput) {
   EXPECT_FALSE(fct::FluoroscopySimulator::writeCase(ct, {}, Eigen::Isometry3d::Identity(), {}, dir / "empty", "slab").ok());
   EXPECT_FALSE(std::filesystem::exists(dir / "empty"));
 }
+
+TEST(FluoroscopySimulator, SequenceFramesAreTheSingleRendersAtEachPoseWithTheirOwnNoise) {
+  const fct::Volume ct = smallPhantom();
+  const std::vector<fct::Camera> cameras{axialCamera(24, 20, 4.0), axialCamera(20, 16, 5.0)};
+  std::vector<Eigen::Isometry3d> poses(3, Eigen::Isometry3d::Identity());
+  poses[1].pretranslate(Eigen::Vector3d(4.0, 0.0, 0.0));
+  poses[2].rotate(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()));
+  fct::FluoroscopyOptions options;
+  options.photonsPerPixel = 2000.0;
+  std::vector<std::vector<fct::FloatImage>> frames;
+  const fct::Status rendered = fct::FluoroscopySimulator::renderSequence(
+      ct, cameras, poses, options, 7, false, [&](int frame, std::vector<fct::FloatImage> images) -> fct::Status {
+        EXPECT_EQ(frame, static_cast<int>(frames.size()));
+        frames.push_back(std::move(images));
+        return fct::Ok{};
+      });
+  ASSERT_TRUE(rendered.ok()) << rendered.error();
+  ASSERT_EQ(frames.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    for (int n = 0; n < 2; ++n) {
+      const auto single = fct::FluoroscopySimulator::render(ct, cameras[n], poses[k], options, 7 + 2 * k + n);
+      ASSERT_TRUE(single.ok()) << single.error();
+      EXPECT_EQ(frames[k][n].pixels, single.value().pixels) << "frame " << k << " view " << n;
+    }
+  }
+  // Same pose, another frame: only the noise differs.
+  const auto again = fct::FluoroscopySimulator::render(ct, cameras[0], poses[0], options, 7 + 2);
+  EXPECT_NE(again.value().pixels, frames[0][0].pixels);
+}
+
+TEST(FluoroscopySimulator, SequenceObjectsFixedInTheWorldStayWhileTheBoneMoves) {
+  const fct::Volume ct = smallPhantom();
+  const std::vector<fct::Camera> cameras{axialCamera(40, 40, 3.0)};
+  std::vector<Eigen::Isometry3d> poses(2, Eigen::Isometry3d::Identity());
+  poses[1].pretranslate(Eigen::Vector3d(0.0, 10.0, 0.0));
+  fct::FluoroscopyOptions options;
+  options.kwireCount = 2;
+  const auto renderAll = [&](bool fixed) {
+    std::vector<fct::FloatImage> out;
+    const fct::Status ok = fct::FluoroscopySimulator::renderSequence(
+        ct, cameras, poses, options, 1, fixed, [&](int, std::vector<fct::FloatImage> images) -> fct::Status {
+          out.push_back(std::move(images.front()));
+          return fct::Ok{};
+        });
+    EXPECT_TRUE(ok.ok()) << ok.error();
+    return out;
+  };
+  const std::vector<fct::FloatImage> moving = renderAll(false);
+  const std::vector<fct::FloatImage> fixed = renderAll(true);
+  ASSERT_EQ(moving.size(), 2u);
+  ASSERT_EQ(fixed.size(), 2u);
+  EXPECT_EQ(fixed[0].pixels, moving[0].pixels) << "at the first pose the objects are where they were placed";
+  EXPECT_NE(fixed[1].pixels, moving[1].pixels) << "later, fixed objects are not carried along with the bone";
+  // Without objects the two modes are the same image.
+  options.kwireCount = 0;
+  EXPECT_EQ(renderAll(true)[1].pixels, renderAll(false)[1].pixels);
+}
+
+TEST(FluoroscopySimulator, SequenceWithoutPosesOrWithABadPoseIsRefused) {
+  const fct::Volume ct = smallPhantom();
+  const auto sink = [](int, std::vector<fct::FloatImage>) -> fct::Status { return fct::Ok{}; };
+  EXPECT_FALSE(fct::FluoroscopySimulator::renderSequence(ct, {axialCamera()}, {}, {}, 1, false, sink).ok());
+  std::vector<Eigen::Isometry3d> poses(2, Eigen::Isometry3d::Identity());
+  poses[1].linear() *= 2.0;
+  const fct::Status bad = fct::FluoroscopySimulator::renderSequence(ct, {axialCamera()}, poses, {}, 1, false, sink);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().find("frame 1"), std::string::npos) << bad.error();
+}
