@@ -198,6 +198,7 @@ Status TrackStepWidget::loadSequence(const std::filesystem::path& viewFile) {
     return fail(sequence.error());
   }
   m_sequence = std::make_shared<const TrackingSequence>(std::move(sequence).value());
+  m_sequenceWindowed = false;
   m_tracked.clear();
   m_chart = QImage();
   m_chartLabel->clear();
@@ -341,7 +342,9 @@ void TrackStepWidget::showFrame(int index) {
   QStringList problems;
   const bool outline = tracked && m_outlineCheck->isChecked() && ensureOverlay();
   for (std::size_t v = 0; v < m_xrayViews.size() && v < images.size(); ++v) {
-    m_xrayViews[v]->setImage(images[v], true);
+    // The first frame shown gets the automatic window of its own values (the case's X-rays may be on another scale);
+    // later frames keep the window, zoom and pan the user set.
+    m_xrayViews[v]->setImage(images[v], m_sequenceWindowed);
     if (!outline) {
       m_xrayViews[v]->clearLayer(kTrackLayer);
       continue;
@@ -355,6 +358,7 @@ void TrackStepWidget::showFrame(int index) {
                                      QColor(ContourOverlay::kFinalColour[0], ContourOverlay::kFinalColour[1],
                                             ContourOverlay::kFinalColour[2]));
   }
+  m_sequenceWindowed = !m_xrayViews.empty();
   if (!problems.isEmpty()) showMessage(problems.join(QLatin1Char('\n')), true);
   m_frameLabel->setText(
       tracked ? tr("Frame %1: %2, image match %3, %4 s%5")
@@ -419,8 +423,9 @@ void TrackStepWidget::restoreViews() {
   const auto& views = m_document->views();
   for (std::size_t v = 0; v < m_xrayViews.size(); ++v) {
     m_xrayViews[v]->clearLayer(kTrackLayer);
-    if (m_sequence && v < views.size()) m_xrayViews[v]->setImage(views[v].xray, true);
+    if (m_sequence && v < views.size()) m_xrayViews[v]->setImage(views[v].xray);
   }
+  m_sequenceWindowed = false;
 }
 
 void TrackStepWidget::setRunningUi(bool running) {

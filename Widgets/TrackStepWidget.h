@@ -112,6 +112,7 @@ class TrackStepWidget : public QWidget {
   std::shared_ptr<const Volume> m_overlayCt;  ///< CT of m_overlay
   std::optional<ContourOverlay> m_overlay;
   QImage m_chart;
+  bool m_sequenceWindowed = false;  ///< the views have the window of a shown frame (else the next one sets it)
 
   TrackingWorker* m_worker = nullptr;
   QThread* m_thread = nullptr;

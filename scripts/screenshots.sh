@@ -2,8 +2,9 @@
 # Builds FluoroCT, makes the built-in case and, when the shared data is there, the same case on the pelvis CT
 # (ct/pelvis_totalseg.nii.gz), and saves a screenshot of FluoroCT Studio at each workflow step of each, under Xvfb,
 # into a folder (default: build/screenshots): studio-<step>.png (built-in case) and pelvis-<step>.png; the Register
-# and Review shots are taken after a registration run from the Register step (--register). Steps the build does not
-# have are skipped. The data folder is $FLUOROCT_DATA_DIR, else ../shared/data beside the repository.
+# and Review shots are taken after a registration run from the Register step (--register), the Track shot after that
+# run and the tracking of a simulated 20-frame sequence of the case's views (--track, `fluoroct simulate --frames`).
+# Steps the build does not have are skipped. The data folder is $FLUOROCT_DATA_DIR, else ../shared/data beside the repository.
 # Usage: scripts/screenshots.sh [FOLDER]
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
@@ -14,9 +15,13 @@ mkdir -p "$OUT"
 # shoot PREFIX CASE: one screenshot per step of the case folder CASE, named PREFIX-<step>.png.
 shoot() {
   local prefix="$1" case="$2"
-  for step in data initial-pose rois register review; do
+  "$FCT_BUILD/bin/fluoroct" simulate --ct "$(ls -d "$case"/ct.* "$case"/ct 2>/dev/null | head -1)" \
+    --views "$case/views.json" --pose "$case/truth_pose.json" --out "$case/cine" --model physical --frames 20 \
+    --noise-photons 20000 --motion-mm 4 --motion-deg 3 --motion-period-frames 30 > /dev/null
+  for step in data initial-pose rois register review track; do
     extra=()
     [[ "$step" == register || "$step" == review ]] && extra=(--register)
+    [[ "$step" == track ]] && extra=(--register --track "$case/cine/views.json")
     if xvfb-run -a -s "-screen 0 1600x1000x24" "$FCT_BUILD/bin/fluoroct-studio" --case "$case" --step "$step" \
         "${extra[@]}" --screenshot "$OUT/$prefix-$step.png" 2> "$OUT/.stderr"; then
       echo "wrote $OUT/$prefix-$step.png"

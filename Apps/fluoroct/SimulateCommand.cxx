@@ -18,6 +18,8 @@
 #include "IO/Project/ViewFile.h"
 #include "IO/Volume/CtLoader.h"
 #include "IO/Volume/VolumeFileIO.h"
+#include "SequenceCaseWriter.h"
+#include "Simulation/BoneMotion.h"
 #include "Simulation/CtSliceDegrader.h"
 #include "Simulation/DrrXraySimulator.h"
 #include "Simulation/FluoroscopySimulator.h"
@@ -51,6 +53,8 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
     double ctSlice_mm = 0.0;
     XraySimulationOptions drr;
     FluoroscopyOptions physical;
+    BoneMotionOptions motion{.frames = 0};  ///< frames 0: single images, no sequence
+    bool toolsFixed = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand(
@@ -132,6 +136,28 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
                       "plate (steel beads of radius 1.5 mm at this pitch, 20 mm from the detector; no patient) through "
                       "the same distortion, noise and blur, for 'fluoroct dewarp-calibrate'; 0 = none")
       ->capture_default_str();
+  BoneMotionOptions& m = options->motion;
+  command->add_option("--frames", m.frames,
+                      "physical: write a fluoroscopy sequence of this many frames of the bone moving (DIR/<view>_<k>.tif, "
+                      "DIR/views.json with each view's \"sequence\", DIR/truth_track.json) for 'fluoroct track'; 0 = "
+                      "single images")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--motion-mm", m.maxTranslation_mm, "sequence: bound of each translation of the bone, mm")
+      ->capture_default_str();
+  command->add_option("--motion-deg", m.maxRotation_deg, "sequence: bound of each rotation of the bone, degrees")
+      ->capture_default_str();
+  command->add_option("--motion-period-frames", m.minPeriod_frames,
+                      "sequence: shortest period of the smooth motion, frames (sets how fast the bone moves; the longest is "
+                      "three times it)")
+      ->capture_default_str();
+  command->add_option("--jerk-frame", m.jerkFrame,
+                      "sequence: frame of a sudden step of the bone (--jerk-mm, --jerk-deg); -1 = none")
+      ->capture_default_str();
+  command->add_option("--jerk-mm", m.jerkTranslation_mm, "sequence: translation of the jerk, mm")->capture_default_str();
+  command->add_option("--jerk-deg", m.jerkRotation_deg, "sequence: rotation of the jerk, degrees")->capture_default_str();
+  command->add_option("--motion-seed", m.seed, "sequence: seed of the motion")->capture_default_str();
+  command->add_flag("--tools-fixed", options->toolsFixed,
+                    "sequence: K-wires, screws and plate stay where they are while the bone moves (held tools)");
   command->callback([&action, options, command] {
     const bool physical = options->model == "physical";
     const auto firstGiven = [command](const auto& names) -> std::string {
@@ -167,6 +193,23 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
       std::error_code ec;
       const std::filesystem::path ctPath = std::filesystem::absolute(options->ct, ec);
       const std::string ctSource = ec ? options->ct : ctPath.string();
+      if (options->motion.frames > 0) {
+        if (!physical) return reportError("--frames needs --model physical (the sequence is rendered by the physical simulator)");
+        if (options->physical.gridPitch_mm > 0.0) return reportError("--grid-pitch-mm does not apply to a sequence (--frames)");
+        if (registrationCt) return reportError("--ct-slice-mm does not apply to a sequence (--frames)");
+        options->motion.maxPeriod_frames = 3.0 * options->motion.minPeriod_frames;
+        auto motion = BoneMotion::create(options->motion);
+        if (!motion.ok()) return reportError(motion.error());
+        options->physical.photonsPerPixel = options->noisePhotons;
+        options->physical.seed = options->seed;
+        auto sequence = SequenceCaseWriter::write(ct.value(), views.value(), pose.value(), motion.value(),
+                                                  options->physical, options->toolsFixed, options->out);
+        if (!sequence.ok()) return reportError(sequence.error());
+        fmt::print("wrote {} ({} frames; track it with fluoroct track --views {}) and {}\n",
+                   sequence.value().viewFile.string(), sequence.value().frames, sequence.value().viewFile.string(),
+                   sequence.value().truthFile.string());
+        return 0;
+      }
       Result<SimulatedCase> simulated = fail("no model");
       if (physical) {
         options->physical.photonsPerPixel = options->noisePhotons;

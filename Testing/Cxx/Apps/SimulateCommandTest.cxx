@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <fstream>
 
+#include "Base/JsonDocument.h"
 #include "Base/TextFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
@@ -215,4 +216,72 @@ TEST(SimulateCommand, GasPocketsWithoutSoftTissueNameTheOption) {
   EXPECT_EQ(run.exitCode, 2);
   EXPECT_EQ(run.err.rfind("error: --gas-pockets: found no soft tissue near the bone", 0), 0u) << run.err;
   EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+}
+
+TEST(SimulateCommand, FramesWriteASequenceCaseThatTrackReads) {
+  const auto dir = fct::test::workDir();
+  makeInputs(dir);
+  const auto out = dir / "sequence";
+  const auto run = fct::test::runCli(simulateCommand(dir, out) +
+                                     " --model physical --frames 4 --motion-mm 6 --motion-deg 4 --jerk-frame 2 "
+                                     "--jerk-mm 3 --jerk-deg 1 --motion-period-frames 8 --noise-photons 5000");
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.out.find("4 frames; track it with fluoroct track"), std::string::npos) << run.out;
+
+  auto views = fct::ViewFile::read(out / "views.json");
+  ASSERT_TRUE(views.ok()) << views.error();
+  ASSERT_EQ(views.value().size(), 3u);
+  for (const fct::ViewSpec& view : views.value()) {
+    ASSERT_TRUE(view.sequence.has_value()) << view.name;
+    ASSERT_EQ(view.sequence->frameCount(), 4) << view.name;
+    for (int f = 0; f < 4; ++f) {
+      auto image = fct::XrayImageFileReader::read(view.sequence->frame(f).first);
+      ASSERT_TRUE(image.ok()) << image.error();
+      EXPECT_EQ(image.value().cols, 100);
+      EXPECT_EQ(image.value().rows, 80);
+    }
+  }
+  // The true poses: frame 0 in truth_pose.json, every frame in truth_track.json; the bone centre moves between frames
+  // and stays within the bound (6 mm per axis) of the base pose.
+  auto first = fct::PoseFile::read(out / "truth_pose.json");
+  ASSERT_TRUE(first.ok()) << first.error();
+  auto truth = fct::JsonDocument::parse(out / "truth_track.json");
+  ASSERT_TRUE(truth.ok()) << truth.error();
+  EXPECT_EQ(truth.value().at("jerk_frame"), 2);
+  const auto& frames = truth.value().at("frames");
+  ASSERT_EQ(frames.size(), 4u);
+  Eigen::Vector3d centre_ct_mm;
+  for (int i = 0; i < 3; ++i) centre_ct_mm[i] = truth.value().at("rotation_centre_ct_mm")[i].get<double>();
+  auto base = fct::PoseFile::read(dir / "pose.json");
+  ASSERT_TRUE(base.ok());
+  std::vector<Eigen::Vector3d> centres_world_mm;
+  for (const auto& frame : frames) {
+    Eigen::Matrix4d T;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) T(r, c) = frame.at("T_world_from_ct")[r][c].get<double>();
+    }
+    centres_world_mm.push_back((T * centre_ct_mm.homogeneous()).head<3>());
+    EXPECT_LE((centres_world_mm.back() - base.value() * centre_ct_mm).cwiseAbs().maxCoeff(), 6.0 + 1e-9);
+  }
+  EXPECT_TRUE(((first.value() * centre_ct_mm) - centres_world_mm.front()).norm() < 1e-6);
+  EXPECT_GT((centres_world_mm[3] - centres_world_mm[0]).norm(), 0.5) << "the bone moved (with a 3 mm jerk)";
+  const auto image0 = fct::XrayImageFileReader::read(views.value()[0].sequence->frame(0).first);
+  const auto image3 = fct::XrayImageFileReader::read(views.value()[0].sequence->frame(3).first);
+  ASSERT_TRUE(image0.ok() && image3.ok());
+  EXPECT_NE(image0.value().pixels, image3.value().pixels) << "the bone moved, and every frame has its own noise";
+}
+
+TEST(SimulateCommand, FramesFailCleanlyOnOptionsThatDoNotApply) {
+  const auto dir = fct::test::workDir();
+  makeInputs(dir);
+  const auto out = dir / "sequence";
+  const std::string base = simulateCommand(dir, out);
+  for (const std::string& extra :
+       {std::string(" --frames 3"), std::string(" --model physical --frames 3 --grid-pitch-mm 5"),
+        std::string(" --model physical --frames 3 --ct-slice-mm 8"), std::string(" --model physical --frames 3 --motion-deg 60"),
+        std::string(" --model physical --frames -2")}) {
+    SCOPED_TRACE(extra);
+    expectOneErrorLine(base + extra);
+  }
+  EXPECT_FALSE(std::filesystem::exists(out)) << "failed runs must not create the case folder";
 }
