@@ -12,14 +12,11 @@
 #include <QVBoxLayout>
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
-#include <set>
 
 #include <fmt/format.h>
 
 #include "Evaluation/LineChart.h"
-#include "Geometry/RigidPose.h"
+#include "Evaluation/TrackPoseChart.h"
 #include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationViewLoader.h"
 #include "Widgets/StudioDocument.h"
@@ -122,7 +119,7 @@ TrackStepWidget::TrackStepWidget(StudioDocument* document, QWidget* parent) : QW
   connect(m_loadButton, &QPushButton::clicked, this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Load a fluoroscopy sequence"), QString(),
                                                       tr("View files (*.json);;All files (*)"));
-    if (!path.isEmpty()) loadSequence(path.toStdString());
+    if (!path.isEmpty()) (void)loadSequence(path.toStdString());  // a failure is shown in the message line
   });
   connect(m_trackButton, &QPushButton::clicked, this, &TrackStepWidget::startTracking);
   connect(m_cancelButton, &QPushButton::clicked, this, &TrackStepWidget::cancel);
@@ -372,30 +369,7 @@ void TrackStepWidget::showFrame(int index) {
 
 void TrackStepWidget::updateChart() {
   if (m_tracked.empty()) return;
-  auto reference = RigidPose::fromTransform(m_tracked.front().T_world_from_ct, m_rotationCentre_ct_mm);
-  if (!reference) return;
-  const PoseVector p0 = reference.value().asVector();
-  static constexpr std::array<const char*, 6> kNames{"rx (deg)", "ry (deg)", "rz (deg)", "tx (mm)", "ty (mm)", "tz (mm)"};
-  ChartSpec spec;
-  spec.title = "Pose change since frame 0 (about the bone centre)";
-  spec.xLabel = "frame";
-  spec.yLabel = "deg / mm";
-  spec.width_px = 640;
-  spec.height_px = 320;
-  double yMin = 0.0;
-  for (std::size_t k = 0; k < kNames.size(); ++k) spec.series.push_back({kNames[k], {}, {}, true});
-  for (const TrackedFrame& frame : m_tracked) {
-    auto params = RigidPose::fromTransform(frame.T_world_from_ct, m_rotationCentre_ct_mm);
-    const PoseVector change =
-        params ? PoseVector(params.value().asVector() - p0) : PoseVector::Constant(std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t k = 0; k < kNames.size(); ++k) {
-      spec.series[k].x.push_back(frame.index);
-      spec.series[k].y.push_back(change[static_cast<int>(k)]);
-      if (std::isfinite(change[static_cast<int>(k)])) yMin = std::min(yMin, change[static_cast<int>(k)]);
-    }
-  }
-  spec.yMin = std::floor(yMin);
-  auto chart = LineChart::draw(spec);
+  auto chart = LineChart::draw(TrackPoseChart::spec(m_tracked, m_rotationCentre_ct_mm, 640, 320));
   if (!chart) {
     showMessage(tr("No pose chart: %1").arg(QString::fromStdString(chart.error())), true);
     return;

@@ -16,6 +16,7 @@
 #include "Base/TextFile.h"
 #include "CliSupport.h"
 #include "Evaluation/LineChart.h"
+#include "Evaluation/TrackPoseChart.h"
 #include "Geometry/RigidPose.h"
 #include "InitialPoseInput.h"
 #include "Interop/IgtlTransformSender.h"
@@ -178,24 +179,7 @@ std::string trackCsv(const TrackRun& run) {
 }
 
 Status writeChart(const TrackRun& run, const fs::path& path) {
-  ChartSpec chart;
-  chart.title = "Tracked pose per frame (rotations about the bone centre, translation of the centre)";
-  chart.xLabel = "frame";
-  chart.yLabel = "deg / mm";
-  const char* names[6] = {"rx (deg)", "ry (deg)", "rz (deg)", "tx (mm)", "ty (mm)", "tz (mm)"};
-  double lo = 0.0, hi = 1.0;
-  for (int k = 0; k < 6; ++k) chart.series.push_back(ChartSeries{names[k], {}, {}, true});
-  for (const TrackedFrame& f : run.frames) {
-    const PoseVector p = parametersOf(run, f);
-    for (int k = 0; k < 6; ++k) {
-      chart.series[static_cast<std::size_t>(k)].x.push_back(f.index);
-      chart.series[static_cast<std::size_t>(k)].y.push_back(p[k]);
-      if (std::isfinite(p[k])) lo = std::min(lo, p[k]), hi = std::max(hi, p[k]);
-    }
-  }
-  chart.yMin = std::floor(lo);
-  chart.yMaxAtLeast = hi;
-  return LineChart::writePng(chart, path);
+  return LineChart::writePng(TrackPoseChart::spec(run.frames, run.centre_ct_mm), path);
 }
 
 /// Writes track.json, track.csv and track.png in --out (each atomically).
