@@ -153,7 +153,7 @@ TEST(RegistrationCase, ReplaceXrayPreparesTheNewFrameAndKeepsTheViewOnBadInput) 
 }
 
 TEST(CineTracker, ExactRefinementFollowsTheFrameStage) {
-  Tracked t = prepare(3, 1);
+  Tracked t = prepare(3);
   fct::CineTrackerOptions options = fastTracker();
   options.refineEvaluations = 15;
   auto tracker = fct::CineTracker::create(t.registrationCase, options);
