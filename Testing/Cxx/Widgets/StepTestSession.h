@@ -26,14 +26,6 @@
 
 namespace fct::test {
 
-/// The small built-in phantom (80 x 80 x 60 voxels of 2 mm) the registration tests use.
-inline Volume smallPhantom() {
-  PhantomOptions options;
-  options.dims = Eigen::Vector3i(80, 80, 60);
-  options.spacing_mm = 2.0;
-  return PhantomBuilder::build(options).value();
-}
-
 /// A document with a simulated case and the views the steps draw on.
 struct StepTestSession {
   StudioDocument document;
