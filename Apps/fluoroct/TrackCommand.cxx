@@ -101,11 +101,7 @@ Result<std::vector<XrayImage>> loadFrame(const Inputs& in, int f) {
 RegistrationCaseOptions caseOptionsFor(const Options& o, DrrMethod method, const Eigen::Isometry3d& T_initial) {
   RegistrationCaseOptions options;
   options.drr.method = method;
-  if (o.transgraphCache == "none") {
-    options.drr.transgraphCacheFolder = std::nullopt;
-  } else if (!o.transgraphCache.empty()) {
-    options.drr.transgraphCacheFolder = fs::path(o.transgraphCache);
-  }
+  options.drr.transgraphCacheFolder = transgraphCacheFolder(o.transgraphCache);
   if (method == DrrMethod::Transgraph) options.T_expected_world_from_ct = T_initial;
   options.preparation.detectFieldOfView = !o.noFieldOfView;
   options.preparation.excludeMetal = !o.noMetalMask;
