@@ -36,6 +36,11 @@ bool parseDetectorSize(const std::string& text, int& cols, int& rows) {
          (separator == 'x' || separator == 'X') && cols >= 1 && rows >= 1;
 }
 
+std::optional<std::filesystem::path> transgraphCacheFolder(const std::string& option) {
+  if (option == "none") return std::nullopt;
+  return std::filesystem::path(option);
+}
+
 CLI::Validator positiveNumber() {
   return CLI::Validator(
       [](std::string& text) -> std::string {

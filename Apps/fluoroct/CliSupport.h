@@ -4,6 +4,8 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <filesystem>
+#include <optional>
 #include <functional>
 #include <string>
 #include <vector>
@@ -27,6 +29,10 @@ void printWarnings(const std::vector<std::string>& warnings);
 
 /// Parses a detector size "COLSxROWS" (e.g. "800x600", x or X) into pixels; false on anything else or a size below 1.
 bool parseDetectorSize(const std::string& text, int& cols, int& rows);
+
+/// The Transgraph cache folder of a --transgraph-cache value: nullopt for "none" (no cache), else the folder (empty =
+/// the default folder).
+std::optional<std::filesystem::path> transgraphCacheFolder(const std::string& option);
 
 /// Option check: the value must be a finite number > 0; the message names the value given.
 CLI::Validator positiveNumber();

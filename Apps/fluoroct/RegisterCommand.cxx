@@ -145,11 +145,7 @@ RegistrationCaseOptions caseOptionsFor(const Options& o, const Inputs& in) {
   options.drr.method = in.method;
   options.drr.rayCastStep_mm = o.rayCastStep_mm;
   options.drr.transgraph.spacing_mm = o.transgraphSpacing_mm;
-  if (o.transgraphCache == "none") {
-    options.drr.transgraphCacheFolder = std::nullopt;
-  } else {
-    options.drr.transgraphCacheFolder = fs::path(o.transgraphCache);
-  }
+  options.drr.transgraphCacheFolder = transgraphCacheFolder(o.transgraphCache);
   if (!o.ablation.noTransgraph) options.T_expected_world_from_ct = in.initial.T_world_from_ct;
   options.preparation.detectFieldOfView = !o.noFieldOfView;
   options.preparation.excludeMetal = !o.noMetalMask;

@@ -102,11 +102,7 @@ Result<std::vector<XrayImage>> loadFrame(const Inputs& in, int f) {
 RegistrationCaseOptions caseOptionsFor(const Options& o, DrrMethod method, const Eigen::Isometry3d& T_initial) {
   RegistrationCaseOptions options;
   options.drr.method = method;
-  if (o.transgraphCache == "none") {
-    options.drr.transgraphCacheFolder = std::nullopt;
-  } else if (!o.transgraphCache.empty()) {
-    options.drr.transgraphCacheFolder = fs::path(o.transgraphCache);
-  }
+  options.drr.transgraphCacheFolder = transgraphCacheFolder(o.transgraphCache);
   if (method == DrrMethod::Transgraph) options.T_expected_world_from_ct = T_initial;
   options.preparation.detectFieldOfView = !o.noFieldOfView;
   options.preparation.excludeMetal = !o.noMetalMask;
@@ -162,6 +158,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                   {"level", o.tracker.level},
                                   {"roi_fraction", o.tracker.roiFraction},
                                   {"max_evaluations", o.tracker.maxEvaluations},
+                                  {"refine_evaluations", o.tracker.refineEvaluations},
                                   {"similarity_drop", o.tracker.similarityDrop},
                                   {"max_jump_mm", o.tracker.maxJump_mm},
                                   {"max_jump_deg", o.tracker.maxJump_deg}}}};
@@ -332,6 +329,10 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
                       "Fraction of the valid pixels in the per-frame dynamic ROIs")
       ->capture_default_str();
   command->add_option("--max-evaluations", options->tracker.maxEvaluations, "Cap on DRR sets of a frame's search")
+      ->capture_default_str();
+  command->add_option("--refine-evaluations", options->tracker.refineEvaluations,
+                      "After the per-frame search, an exact-DRR refinement with this cap on DRR sets (0 = none; for "
+                      "--method transgraph)")
       ->capture_default_str();
   command->add_option("--similarity-drop", options->tracker.similarityDrop,
                       "Lost track: similarity below (1 - this) times the running level")

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <ctime>
 #include <utility>
 
@@ -30,6 +31,9 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   if (!(o.roiFraction > 0.0 && o.roiFraction <= 1.0)) {
     return fail(fmt::format("tracking ROI fraction must be in (0, 1], got {}", o.roiFraction));
   }
+  if (o.refineEvaluations < 0) {
+    return fail(fmt::format("tracking refinement cap must be >= 0 (0 = none), got {}", o.refineEvaluations));
+  }
   if (o.maxEvaluations <= 0) return fail(fmt::format("tracking evaluation cap must be > 0, got {}", o.maxEvaluations));
   if (!(o.initialStep > 0.0) || !(o.tolerance > 0.0) || !(o.tolerance < o.initialStep)) {
     return fail(fmt::format("tracking step {} and tolerance {} must be positive with the tolerance below the step",
@@ -47,8 +51,9 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   return Ok{};
 }
 
-/// The frame stage of the options: VLNC on dynamic ROIs at the tracking level with one local BOBYQA search.
-RegistrationStage frameStageOf(const CineTrackerOptions& o) {
+/// The frame schedule of the options: VLNC on dynamic ROIs at the tracking level with one local BOBYQA search, then
+/// with refineEvaluations > 0 the same with exact DRRs, a smaller step and that cap.
+RegistrationSchedule frameScheduleOf(const CineTrackerOptions& o) {
   RegistrationStage stage;
   stage.name = fmt::format("track-vlnc-rois-level{}", o.level);
   stage.metric = SimilarityMetric::Vlnc;
@@ -64,7 +69,17 @@ RegistrationStage frameStageOf(const CineTrackerOptions& o) {
   stage.simplex.tolerance = o.tolerance;
   stage.simplex.maxEvaluations = o.maxEvaluations;
   stage.simplex.restarts = 0;
-  return stage;
+  RegistrationSchedule schedule;
+  schedule.name = "tracking";
+  schedule.stages = {stage};
+  if (o.refineEvaluations > 0) {
+    stage.name += "-exact";
+    stage.exactDrr = true;
+    stage.maxEvaluations = stage.simplex.maxEvaluations = o.refineEvaluations;
+    stage.simplex.initialStep = std::max(2.0 * o.tolerance, 0.5 * o.initialStep);
+    schedule.stages.push_back(stage);
+  }
+  return schedule;
 }
 
 /// The pose predicted for the next frame: `previous` moved on by the motion from `beforePrevious` to it, in pose
@@ -90,15 +105,15 @@ const char* CineTracker::statusName(TrackedFrameStatus status) {
   return "lost";
 }
 
-CineTracker::CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options, RegistrationStage frameStage)
-    : m_case(&registrationCase), m_options(std::move(options)), m_frameStage(std::move(frameStage)) {
-  m_frameSchedule.name = "tracking";
-  m_frameSchedule.stages = {m_frameStage};
+CineTracker::CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options,
+                         RegistrationSchedule frameSchedule)
+    : m_case(&registrationCase), m_options(std::move(options)), m_frameSchedule(std::move(frameSchedule)) {
   m_recoverySchedule.name = m_options.firstFrame.schedule.name + "-recovery";
   for (const RegistrationStage& stage : m_options.firstFrame.schedule.stages) {
     if (stage.search != SearchStrategy::Local) m_recoverySchedule.stages.push_back(stage);
   }
-  m_recoverySchedule.stages.push_back(m_frameStage);
+  m_recoverySchedule.stages.insert(m_recoverySchedule.stages.end(), m_frameSchedule.stages.begin(),
+                                   m_frameSchedule.stages.end());
 }
 
 Result<CineTracker> CineTracker::create(RegistrationCase& registrationCase, const CineTrackerOptions& options) {
@@ -109,8 +124,8 @@ Result<CineTracker> CineTracker::create(RegistrationCase& registrationCase, cons
     if (!schedule) return fail(schedule.error());
     resolved.firstFrame.schedule = std::move(schedule).value();
   }
-  RegistrationStage stage = frameStageOf(resolved);
-  return CineTracker(registrationCase, std::move(resolved), std::move(stage));
+  RegistrationSchedule frameSchedule = frameScheduleOf(resolved);
+  return CineTracker(registrationCase, std::move(resolved), std::move(frameSchedule));
 }
 
 Status CineTracker::runSchedule(const RegistrationSchedule& schedule, const Eigen::Isometry3d& T_start,
@@ -149,8 +164,9 @@ Result<TrackedFrame> CineTracker::trackFirst(const Eigen::Isometry3d& T_initial,
   frame.T_world_from_ct = result.value().T_world_from_ct;
   frame.drrs = result.value().totalDrrs;
   frame.cancelled = result.value().cancelled;
-  // The running level starts at the frame stage's similarity at the registered pose (the stage's own metric).
-  auto objective = RegistrationObjective::create(*m_case, m_frameStage, !m_frameStage.exactDrr,
+  // The running level starts at the last frame stage's similarity at the registered pose (the stage's own metric).
+  const RegistrationStage& judged = m_frameSchedule.stages.back();
+  auto objective = RegistrationObjective::create(*m_case, judged, !judged.exactDrr,
                                                  frame.T_world_from_ct, frame.T_world_from_ct);
   if (!objective) return fail("frame 0: " + objective.error());
   auto similarity = objective.value().similarity(frame.T_world_from_ct);

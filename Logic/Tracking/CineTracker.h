@@ -4,9 +4,9 @@
 // (the default preset). Every later frame swaps each view's X-ray for the new frame (RegistrationCase::replaceXray),
 // starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre)
 // and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
-// run by Registration with RegistrationObjective). A frame whose similarity falls below (1 - similarityDrop) times the
+// run by Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose similarity falls below (1 - similarityDrop) times the
 // running level, or whose pose differs from the prediction by more than the jump limits, is re-registered from the
-// prediction with the global stage(s) of the first-frame schedule followed by the frame stage: it is `Recovered` when
+// prediction with the global stage(s) of the first-frame schedule followed by the frame stage(s): it is `Recovered` when
 // that restores the level (and the jump limits hold), else `Lost` (the next frame then starts from the last trusted
 // pose without velocity).
 
@@ -65,6 +65,9 @@ struct CineTrackerOptions {
   /// Render the frame stage with the case's exact renderer (Siddon on the CT coarsened to the level) even when the
   /// case has Transgraph tables; false uses the tables (built once around frame 0's initial pose).
   bool exactDrr = false;
+  /// > 0: the frame stage is followed by an exact-DRR BOBYQA refinement at the same level and ROIs with this cap on
+  /// DRR sets (for Transgraph tables, whose interpolation is too coarse for the final pose); 0: none.
+  int refineEvaluations = 0;
   bool constantVelocity = true;   ///< predict previous pose + last inter-frame motion (false: previous pose)
   double similarityDrop = 0.25;   ///< lost when similarity < (1 - similarityDrop) * running level, 0 < d < 1
   double levelWeight = 0.2;       ///< weight of a new tracked frame in the running level (exponential mean), 0 < w <= 1
@@ -90,15 +93,16 @@ class CineTracker {
   /// frame is a success with `cancelled` set.
   Result<TrackedFrame> trackNext(const std::vector<XrayImage>& frameImages, const std::atomic<bool>* cancel = nullptr);
 
-  /// The frame stage (VLNC on ROIs at the tracker's level, local BOBYQA), as run on every frame after the first.
-  const RegistrationStage& frameStage() const { return m_frameStage; }
+  /// The stages run on every frame after the first: the frame stage (VLNC on ROIs at the tracker's level, local
+  /// BOBYQA) and, with refineEvaluations > 0, its exact-DRR refinement; frame similarities are the last stage's.
+  const RegistrationSchedule& frameSchedule() const { return m_frameSchedule; }
   /// The options the tracker runs with (the first-frame schedule resolved).
   const CineTrackerOptions& options() const { return m_options; }
   /// Lowercase name of a status ("tracked", "recovered", "lost").
   static const char* statusName(TrackedFrameStatus status);
 
  private:
-  CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options, RegistrationStage frameStage);
+  CineTracker(RegistrationCase& registrationCase, CineTrackerOptions options, RegistrationSchedule frameSchedule);
   /// Runs `schedule` from T_start and folds its result into `frame` (pose, similarity, DRRs, cancelled); fails with
   /// Registration's message.
   Status runSchedule(const RegistrationSchedule& schedule, const Eigen::Isometry3d& T_start,
@@ -108,9 +112,8 @@ class CineTracker {
 
   RegistrationCase* m_case;
   CineTrackerOptions m_options;
-  RegistrationStage m_frameStage;
-  RegistrationSchedule m_frameSchedule;     ///< the frame stage alone
-  RegistrationSchedule m_recoverySchedule;  ///< the first-frame schedule's global stages, then the frame stage
+  RegistrationSchedule m_frameSchedule;     ///< the frame stage (and its refinement)
+  RegistrationSchedule m_recoverySchedule;  ///< the first-frame schedule's global stages, then the frame schedule
   int m_nextIndex = 0;
   double m_runningLevel = 0.0;
   std::optional<Eigen::Isometry3d> m_T_previous;       ///< last trusted pose

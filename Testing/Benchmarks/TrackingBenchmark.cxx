@@ -7,7 +7,8 @@
 //
 // Usage: fluoroct_tracking_benchmark --ct CT [--views 1|2] [--size PIXELS] [--pixel-mm MM] [--frames N]
 //                                    [--amplitude-mm MM] [--amplitude-deg DEG] [--period FRAMES] [--level L]
-//                                    [--roi-fraction F] [--max-evaluations N] [--method siddon|transgraph|both]
+//                                    [--roi-fraction F] [--max-evaluations N] [--refine-evaluations N]
+//                                    [--method siddon|transgraph|both]
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
@@ -101,6 +102,8 @@ int main(int argc, char** argv) {
   app.add_option("--level", trackerOptions.level, "Tracking pyramid level")->capture_default_str();
   app.add_option("--roi-fraction", trackerOptions.roiFraction, "Tracking ROI fraction")->capture_default_str();
   app.add_option("--max-evaluations", trackerOptions.maxEvaluations, "Tracking evaluation cap")->capture_default_str();
+  app.add_option("--refine-evaluations", trackerOptions.refineEvaluations, "Exact refinement cap (0 = none)")
+      ->capture_default_str();
   app.add_option("--method", method, "siddon, transgraph or both")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 

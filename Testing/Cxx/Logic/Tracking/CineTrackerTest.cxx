@@ -151,3 +151,23 @@ TEST(RegistrationCase, ReplaceXrayPreparesTheNewFrameAndKeepsTheViewOnBadInput) 
   EXPECT_FALSE(c.replaceXray(5, t.sequence.frames[1][0]).ok());
   EXPECT_EQ(c.prepared(0).pyramid.level(1).image.pixels, frame1);
 }
+
+TEST(CineTracker, ExactRefinementFollowsTheFrameStage) {
+  Tracked t = prepare(3);
+  fct::CineTrackerOptions options = fastTracker();
+  options.refineEvaluations = 15;
+  auto tracker = fct::CineTracker::create(t.registrationCase, options);
+  ASSERT_TRUE(tracker.ok()) << tracker.error();
+  ASSERT_EQ(tracker.value().frameSchedule().stages.size(), 2u);
+  EXPECT_TRUE(tracker.value().frameSchedule().stages.back().exactDrr);
+  EXPECT_EQ(tracker.value().frameSchedule().stages.back().maxEvaluations, 15);
+  ASSERT_TRUE(tracker.value().trackFirst(firstStart(t)).ok());
+  for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
+    auto frame = tracker.value().trackNext(t.sequence.frames[f]);
+    ASSERT_TRUE(frame.ok()) << frame.error();
+    EXPECT_EQ(frame.value().status, fct::TrackedFrameStatus::Tracked) << "frame " << f;
+    EXPECT_LT(errorOf(t, frame.value()), 1.0) << "frame " << f;
+  }
+  options.refineEvaluations = -1;
+  EXPECT_FALSE(fct::CineTracker::create(t.registrationCase, options).ok());
+}
