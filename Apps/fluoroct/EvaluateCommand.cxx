@@ -280,10 +280,11 @@ int runMerge(const EvaluateOptions& o, const StudyDefinition& known) {
   return 0;
 }
 
-/// The resume check of a tracking study: the options that change its results, one per line.
+/// The resume check of a tracking study: the options that change its results, one per line (--trials may change:
+/// more sequences add to the stored ones).
 std::string trackingSetupText(const EvaluateOptions& o, const TrackingStudyDefinition& study) {
-  return fmt::format("study: tracking\nquick: {}\ncts: {}\npreset: {}\nsequences: {}\nframes: {}\nseed: {}\n",
-                     o.quick, fmt::join(o.cts, " "), study.preset, o.trials, study.motion.frames, study.seed);
+  return fmt::format("study: tracking\nquick: {}\ncts: {}\npreset: {}\nframes: {}\nseed: {}\n", o.quick,
+                     fmt::join(o.cts, " "), study.preset, study.motion.frames, study.seed);
 }
 
 /// --study tracking: simulates and tracks the sequences (TrackingStudy) into DIR/frames.json (resumable) and

@@ -9,6 +9,7 @@
 
 #include "Base/JsonDocument.h"
 #include "Base/TextFile.h"
+#include "Evaluation/TrialStore.h"
 
 namespace fct {
 
@@ -79,16 +80,7 @@ TrackingFrameRecord fromJson(const nlohmann::json& j) {
   return r;
 }
 
-/// A CSV field: quoted when it holds a comma or a quote (line breaks become spaces).
-std::string csvField(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"') out += '"';
-    out += c == '\n' || c == '\r' ? ' ' : c;
-  }
-  return out + "\"";
-}
+std::string field(const std::string& text) { return TrialStore::csvField(text); }
 
 std::string csvNumber(double value) { return std::isnan(value) ? "nan" : fmt::format("{:.6g}", value); }
 
@@ -144,12 +136,12 @@ std::string TrackingFrameStore::toCsv(const std::vector<TrackingFrameRecord>& re
       "motion_from_first_mm,initial_stre_mm,stre_mean_mm,stre_max_mm,in_plane_mm,out_of_plane_mm,rotation_deg,"
       "translation_mm,reason\n";
   for (const TrackingFrameRecord& r : records) {
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csvField(r.condition),
-                       csvField(r.ct), r.views, r.sequence, r.frames, r.frame, r.seed, r.status, r.cancelled ? 1 : 0,
+    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", field(r.condition),
+                       field(r.ct), r.views, r.sequence, r.frames, r.frame, r.seed, r.status, r.cancelled ? 1 : 0,
                        csvNumber(r.similarity), csvNumber(r.seconds), csvNumber(r.cpuSeconds), r.drrs,
                        csvNumber(r.motionFromFirst_mm), csvNumber(r.initialStre_mm), csvNumber(r.streMean_mm),
                        csvNumber(r.streMax_mm), csvNumber(r.inPlane_mm), csvNumber(r.outOfPlane_mm),
-                       csvNumber(r.rotation_deg), csvNumber(r.translation_mm), csvField(r.reason));
+                       csvNumber(r.rotation_deg), csvNumber(r.translation_mm), field(r.reason));
   }
   return out;
 }

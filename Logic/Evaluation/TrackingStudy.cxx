@@ -72,19 +72,33 @@ Result<std::vector<ViewSpec>> viewsFor(const TrackingStudyDefinition& study, con
   return StandardViews::build(Eigen::Vector3d::Zero(), o);
 }
 
+/// Which frame of which sequence a record is.
+struct FrameKey {
+  const TrackingCondition& condition;
+  int sequence = 0;
+  std::uint32_t seed = 0;
+  int frames = 0;
+  int frame = 0;
+};
+
+/// A record holding only the frame's identification.
+TrackingFrameRecord identifiedFrame(const FrameKey& key) {
+  TrackingFrameRecord r;
+  r.condition = key.condition.name;
+  r.ct = key.condition.ct;
+  r.views = key.condition.viewCount;
+  r.sequence = key.sequence;
+  r.frames = key.frames;
+  r.frame = key.frame;
+  r.seed = key.seed;
+  return r;
+}
+
 /// The frame's record without the tracker's part: identification and the errors of `T_estimate`.
-TrackingFrameRecord measuredFrame(const TrackingCondition& c, int sequence, std::uint32_t seed, int frames, int frame,
-                                  const TrackingScene& scene, const std::vector<ViewSpec>& views,
+TrackingFrameRecord measuredFrame(const FrameKey& key, const TrackingScene& scene, const std::vector<ViewSpec>& views,
                                   const Eigen::Isometry3d& T_truth, const Eigen::Isometry3d& T_firstTruth,
                                   const Eigen::Isometry3d& T_start, const Eigen::Isometry3d& T_estimate) {
-  TrackingFrameRecord r;
-  r.condition = c.name;
-  r.ct = c.ct;
-  r.views = c.viewCount;
-  r.sequence = sequence;
-  r.frames = frames;
-  r.frame = frame;
-  r.seed = seed;
+  TrackingFrameRecord r = identifiedFrame(key);
   r.motionFromFirst_mm = scene.metrics->measure(T_truth, T_firstTruth).streMean_mm;
   r.initialStre_mm = scene.metrics->measure(T_start, T_truth).streMean_mm;
   const PoseError error = scene.metrics->measure(T_estimate, T_truth);
@@ -92,7 +106,7 @@ TrackingFrameRecord measuredFrame(const TrackingCondition& c, int sequence, std:
   r.streMax_mm = error.streMax_mm;
   r.rotation_deg = error.rotation_deg;
   r.translation_mm = error.translation_mm;
-  if (c.viewCount == 1) {
+  if (key.condition.viewCount == 1) {
     const ViewPlaneError inView =
         scene.metrics->measureInView(T_estimate, T_truth, views.front().camera.T_world_from_camera().translation());
     r.inPlane_mm = inView.inPlaneMean_mm;
@@ -114,17 +128,9 @@ void addTrackerPart(const TrackedFrame& f, TrackingFrameRecord& r) {
 }
 
 /// The record of a frame the tracker returned an error for (NaN errors, status "failed").
-TrackingFrameRecord failedFrame(const TrackingCondition& c, int sequence, std::uint32_t seed, int frames, int frame,
-                                const std::string& reason) {
+TrackingFrameRecord failedFrame(const FrameKey& key, const std::string& reason) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  TrackingFrameRecord r;
-  r.condition = c.name;
-  r.ct = c.ct;
-  r.views = c.viewCount;
-  r.sequence = sequence;
-  r.frames = frames;
-  r.frame = frame;
-  r.seed = seed;
+  TrackingFrameRecord r = identifiedFrame(key);
   r.status = "failed";
   r.similarity = r.seconds = r.cpuSeconds = nan;
   r.motionFromFirst_mm = r.initialStre_mm = r.streMean_mm = r.streMax_mm = nan;
@@ -183,13 +189,14 @@ Result<std::vector<TrackingFrameRecord>> runSequence(const TrackingStudyDefiniti
     if (options.onMessage) options.onMessage(fmt::format("{} sequence {}: tracking frame {}", c.name, sequence, k));
     auto tracked = k == 0 ? tracker.value().trackFirst(T_start.value(), options.cancel)
                           : tracker.value().trackNext(images[k], options.cancel);
+    const FrameKey key{c, sequence, seed, frames, k};
     if (!tracked) {
-      out.push_back(failedFrame(c, sequence, seed, frames, k, tracked.error()));
+      out.push_back(failedFrame(key, tracked.error()));
       break;
     }
     const TrackedFrame& f = tracked.value();
-    TrackingFrameRecord r = measuredFrame(c, sequence, seed, frames, k, scene, views.value(), truth[k], truth[0],
-                                          f.T_predicted_world_from_ct, f.T_world_from_ct);
+    TrackingFrameRecord r = measuredFrame(key, scene, views.value(), truth[k], truth[0], f.T_predicted_world_from_ct,
+                                          f.T_world_from_ct);
     addTrackerPart(f, r);
     out.push_back(r);
     if (f.cancelled) break;

@@ -18,16 +18,6 @@ namespace {
 constexpr NameTable<TrialStatus, 3> kStatusNames{
     {{"ok", TrialStatus::Ok}, {"failed", TrialStatus::Failed}, {"cancelled", TrialStatus::Cancelled}}};
 
-std::string quoted(const std::string& field) {
-  if (field.find_first_of(",\"\n\r") == std::string::npos) return field;
-  std::string out = "\"";
-  for (char c : field) {
-    if (c == '"') out += '"';
-    out += c == '\n' || c == '\r' ? ' ' : c;
-  }
-  return out + "\"";
-}
-
 std::string number(double value) {
   if (std::isnan(value)) return "nan";
   return fmt::format("{:.6g}", value);
@@ -78,6 +68,16 @@ bool parseInt(const std::string& text, Int& out) {
 
 std::string_view trialStatusName(TrialStatus status) { return nameOf(status, kStatusNames); }
 
+std::string TrialStore::csvField(const std::string& field) {
+  if (field.find_first_of(",\"\n\r") == std::string::npos) return field;
+  std::string out = "\"";
+  for (char c : field) {
+    if (c == '"') out += '"';
+    out += c == '\n' || c == '\r' ? ' ' : c;
+  }
+  return out + "\"";
+}
+
 Result<TrialStatus> parseTrialStatus(std::string_view text) {
   if (const auto status = valueNamed(text, kStatusNames)) return *status;
   return fail(fmt::format("unknown trial status '{}'; the status is ok, failed or cancelled", text));
@@ -97,12 +97,12 @@ std::string TrialStore::toCsv(const std::vector<TrialRecord>& records) {
   for (std::size_t c = 0; c < columns().size(); ++c) text += (c ? "," : "") + columns()[c];
   text += '\n';
   for (const TrialRecord& r : records) {
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", quoted(r.study), quoted(r.ct),
-                        quoted(r.condition), quoted(r.scenario), quoted(r.variant), r.views, r.trial, r.seed,
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csvField(r.study), csvField(r.ct),
+                        csvField(r.condition), csvField(r.scenario), csvField(r.variant), r.views, r.trial, r.seed,
                         number(r.initialTarget_mm), number(r.initialStre_mm), number(r.error.streMean_mm),
                         number(r.error.streMax_mm), number(r.error.mtre_mm), number(r.error.rotation_deg),
                         number(r.error.translation_mm), r.success ? 1 : 0, number(r.seconds), number(r.setupSeconds), r.drrs,
-                        trialStatusName(r.status), quoted(r.reason));
+                        trialStatusName(r.status), csvField(r.reason));
   }
   return text;
 }

@@ -71,6 +71,9 @@ class TrialStore {
 
   /// The CSV text of `records` (header line, then one line per record; fields with commas or quotes are quoted).
   static std::string toCsv(const std::vector<TrialRecord>& records);
+  /// `text` as one CSV field: quoted (inner quotes doubled, line breaks as spaces) when it holds a comma, quote or line
+  /// break, else as it is.
+  static std::string csvField(const std::string& text);
   /// Parses CSV text written by toCsv(); `where` names the source in messages.
   static Result<std::vector<TrialRecord>> fromCsv(const std::string& text, const std::string& where);
 
