@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -12,6 +13,22 @@
 namespace fct {
 
 namespace {
+
+/// True when the file starts with the signature of its format (PNG: 89 'PNG' 0D 0A 1A 0A; TIFF: "II*\0", "MM\0*", or
+/// BigTIFF "II+\0", "MM\0+"). OpenCV picks its decoder from the content, not the name: without this check a file
+/// named .png holding, say, DICOM bytes reaches a decoder (GDCM) that aborts the program on damaged input.
+bool hasSignature(const std::filesystem::path& path, const std::string& modality) {
+  std::ifstream file(path, std::ios::binary);
+  char head[8] = {};
+  file.read(head, sizeof head);
+  const std::string bytes(head, static_cast<std::size_t>(file.gcount()));
+  if (modality == "PNG") return bytes == std::string("\x89PNG\r\n\x1a\n", 8);
+  const std::string first4 = bytes.substr(0, 4);
+  for (const char* tiff : {"II*\0", "MM\0*", "II+\0", "MM\0+"}) {
+    if (first4 == std::string(tiff, 4)) return true;
+  }
+  return false;
+}
 
 /// True when every pixel has equal B, G and R values (a grey image stored as colour).
 bool channelsEqual(const cv::Mat& bgr) {
@@ -38,6 +55,11 @@ Result<XrayImage> XrayImageFileReader::read(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return fail(fmt::format("X-ray file '{}' does not exist", path.string()));
 
+  if (!hasSignature(path, modality)) {
+    return fail(fmt::format("'{}' is not a {} file: it does not start with the {} signature (damaged, or another format "
+                            "under a .{} name)",
+                            path.filename().string(), modality, modality, extension.substr(1)));
+  }
   std::vector<std::string> warnings;
   cv::Mat grey;
   try {

@@ -90,7 +90,8 @@ TEST(XrayImageFileReader, RejectsUnknownExtensionCorruptAndMissingFiles) {
 
   EXPECT_NE(XrayImageFileReader::read(dir / "absent.png").error().find("does not exist"), std::string::npos);
 
-  std::ofstream(dir / "broken.tif") << "II*\0garbage that is not a TIFF directory";
+  const std::string brokenTiff("II*\0garbage that is not a TIFF directory", 41);
+  std::ofstream(dir / "broken.tif", std::ios::binary) << brokenTiff;
   auto broken = XrayImageFileReader::read(dir / "broken.tif");
   ASSERT_FALSE(broken);
   EXPECT_NE(broken.error().find("cannot"), std::string::npos) << broken.error();
@@ -99,4 +100,23 @@ TEST(XrayImageFileReader, RejectsUnknownExtensionCorruptAndMissingFiles) {
   auto signedImage = XrayImageFileReader::read(dir / "signed.tif");
   ASSERT_FALSE(signedImage);
   EXPECT_NE(signedImage.error().find("unsupported pixel type"), std::string::npos) << signedImage.error();
+}
+
+TEST(XrayImageFileReader, RejectsAFileWhoseBytesAreNotItsFormat) {
+  // OpenCV chooses its decoder from the bytes; DICOM bytes named .png once reached GDCM, which aborted on them
+  // (Testing/Fuzz/regressions/xray_png).
+  const auto dir = fct::test::scratchDir();
+  const std::string dicomLike = std::string(128, '\0') + "DICM" + std::string(64, '&');
+  std::ofstream(dir / "dicom.png", std::ios::binary) << dicomLike;
+  auto png = XrayImageFileReader::read(dir / "dicom.png");
+  ASSERT_FALSE(png);
+  EXPECT_NE(png.error().find("'dicom.png' is not a PNG file: it does not start with the PNG signature"), std::string::npos)
+      << png.error();
+
+  ASSERT_TRUE(cv::imwrite((dir / "real.png").string(), cv::Mat(4, 4, CV_8U, cv::Scalar(7))));
+  std::filesystem::copy_file(dir / "real.png", dir / "png_named.tif", std::filesystem::copy_options::overwrite_existing);
+  auto tif = XrayImageFileReader::read(dir / "png_named.tif");
+  ASSERT_FALSE(tif);
+  EXPECT_NE(tif.error().find("is not a TIFF file"), std::string::npos) << tif.error();
+  EXPECT_TRUE(XrayImageFileReader::read(dir / "real.png").ok());
 }
