@@ -23,6 +23,7 @@
 #include "Widgets/RegistrationWorker.h"
 #include "Widgets/RunTimeEstimator.h"
 #include "Widgets/StudioDocument.h"
+#include "Widgets/WorkerThread.h"
 
 namespace fct {
 
@@ -509,15 +510,7 @@ void RegisterStepWidget::onFailed(const QString& message) {
   emit runningChanged(false);
 }
 
-void RegisterStepWidget::endThread() {
-  if (!m_thread) return;
-  m_thread->quit();
-  m_thread->wait();
-  delete m_worker;
-  delete m_thread;
-  m_worker = nullptr;
-  m_thread = nullptr;
-}
+void RegisterStepWidget::endThread() { endWorkerThread(m_thread, m_worker); }
 
 void RegisterStepWidget::setRunningUi(bool running) {
   m_cancelButton->setEnabled(running);

@@ -20,6 +20,7 @@
 #include "IO/Project/ViewFile.h"
 #include "Registration/RegistrationViewLoader.h"
 #include "Widgets/StudioDocument.h"
+#include "Widgets/WorkerThread.h"
 #include "Widgets/XrayViewWidget.h"
 
 namespace fct {
@@ -316,15 +317,7 @@ void TrackStepWidget::onFailed(const QString& message) {
   emit runningChanged(false);
 }
 
-void TrackStepWidget::endThread() {
-  if (!m_thread) return;
-  m_thread->quit();
-  m_thread->wait();
-  delete m_worker;
-  delete m_thread;
-  m_worker = nullptr;
-  m_thread = nullptr;
-}
+void TrackStepWidget::endThread() { endWorkerThread(m_thread, m_worker); }
 
 void TrackStepWidget::showFrame(int index) {
   if (!m_sequence) return;
