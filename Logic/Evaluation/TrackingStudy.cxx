@@ -279,7 +279,7 @@ Result<TrackingRunSummary> TrackingStudy::run(const TrackingStudyDefinition& stu
   std::map<std::string, TrackingScene> scenes;
   for (const auto& [c, s] : pending) {
     if (scenes.count(c->ct)) continue;
-    const StudyCt& ct = *std::find_if(cts.begin(), cts.end(), [&](const StudyCt& x) { return x.label == c->ct; });
+    const StudyCt& ct = *std::find_if(cts.begin(), cts.end(), [&label = c->ct](const StudyCt& x) { return x.label == label; });
     auto metrics = PoseErrorMetrics::create(ct.volume);
     if (!metrics) return fail(fmt::format("CT '{}': {}", ct.label, metrics.error()));
     TrackingScene scene;
