@@ -1,6 +1,5 @@
 // Replays, through the fuzz entry points, every kept input of Testing/Fuzz/regressions/<target>/ (inputs that once
-// crashed a loader, minimized) and Testing/Fuzz/seeds/<target>/ (tiny hand-made seeds), the seeds the project's
-// writers make and the crafted inputs of fixed defects (FuzzSeedWriter), and a few real files of ../shared/data: none
+// crashed a loader, minimized), the seeds the project's writers make and the crafted inputs of fixed defects (FuzzSeedWriter), and a few real files of ../shared/data: none
 // may crash, hang or break a loader's contract (that aborts the program).
 
 #include <gtest/gtest.h>
@@ -63,7 +62,7 @@ std::vector<fs::path> sharedDataInputsOf(const std::string& target) {
 
 std::vector<fs::path> inputsOf(const std::string& target) {
   std::vector<fs::path> inputs = sharedDataInputsOf(target);
-  for (const fs::path& root : {fs::path(FCT_FUZZ_DIR) / "regressions", fs::path(FCT_FUZZ_DIR) / "seeds", writtenSeeds()}) {
+  for (const fs::path& root : {fs::path(FCT_FUZZ_DIR) / "regressions", writtenSeeds()}) {
     std::error_code ec;
     if (!fs::is_directory(root / target, ec)) continue;
     for (const auto& entry : fs::directory_iterator(root / target)) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@
 #include "IO/Xray/ImageFileWriter.h"
 #include "IO/Xray/XrayLoader.h"
 #include "Registration/RegistrationSchedule.h"
+#include "SyntheticCtDicom.h"
+#include "SyntheticXrayDicom.h"
 
 namespace fct::fuzz {
 namespace fs = std::filesystem;
@@ -132,6 +135,70 @@ Status writeBinarySeeds(const fs::path& root) {
   return DewarpFile::write(contents, root / "dewarp" / "field.dewarp.json");
 }
 
+/// The bytes of a DICOM file as DCMTK saves the dataset (Explicit VR Little Endian), through a file beside `scratch`.
+Result<std::string> dicomBytes(DcmFileFormat& file, const fs::path& scratch) {
+  if (!file.saveFile(scratch.c_str(), EXS_LittleEndianExplicit).good()) {
+    return fail(fmt::format("cannot write the DICOM seed {}", scratch.string()));
+  }
+  std::ifstream in(scratch, std::ios::binary);
+  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::error_code ec;
+  fs::remove(scratch, ec);
+  return bytes;
+}
+
+/// A dicom_series input: the slices' files joined by kFileSeparator.
+Result<std::string> seriesBytes(const std::vector<test::SyntheticSlice>& slices, const fs::path& scratch) {
+  std::string joined;
+  for (const test::SyntheticSlice& slice : slices) {
+    DcmFileFormat file = slice.build();
+    auto bytes = dicomBytes(file, scratch);
+    if (!bytes) return fail(bytes.error());
+    if (!joined.empty()) joined += kFileSeparator;
+    joined += bytes.value();
+  }
+  return joined;
+}
+
+/// DICOM inputs made with DCMTK: a 16x16 DX with C-arm tags, a 2-slice CT series, and the series of the loader defect
+/// fuzzing found (3 tilted slices, the last moved 12.5 km in-plane, whose resampled grid would hold gigabytes).
+Status writeDicomSeeds(const fs::path& root) {
+  const fs::path scratch = root / "dicom_seed.tmp";
+  test::SyntheticXray dx;
+  dx.modality = "DX";
+  dx.cols = dx.rows = 16;
+  for (int n = 0; n < dx.cols * dx.rows; ++n) dx.samples.push_back(static_cast<Uint16>(1000 + 37 * n));
+  DcmFileFormat dxFile = dx.build();
+  test::putCarmTags(*dxFile.getDataset(), 1000.0, 600.0, 0.3, 0.3, 10.0, -5.0);
+  auto dxBytes = dicomBytes(dxFile, scratch);
+  if (!dxBytes) return fail(dxBytes.error());
+  if (Status written = writeBytes(root / "xray_dicom" / "dx_16px.dcm", dxBytes.value()); !written) return written;
+
+  test::SyntheticSlice slice;
+  slice.cols = slice.rows = 16;
+  slice.stored = [](int i, int j) { return 40 * i - 25 * j; };
+  std::vector<test::SyntheticSlice> pair(2, slice);
+  pair[1].ipp_lps_mm.z() = 2.5;
+  auto pairBytes = seriesBytes(pair, scratch);
+  if (!pairBytes) return fail(pairBytes.error());
+  if (Status written = writeBytes(root / "dicom_series" / "two_slices_16px.bin", pairBytes.value()); !written) {
+    return written;
+  }
+
+  test::SyntheticSlice tilted;
+  tilted.cols = tilted.rows = 32;
+  tilted.rowSpacing_mm = tilted.columnSpacing_mm = 7.8125;
+  tilted.sliceThickness_mm = 4.0;
+  tilted.iop = {1, 0, 0, 0, 0.9483237, -0.3173047};
+  std::vector<test::SyntheticSlice> farApart(3, tilted);
+  farApart[0].ipp_lps_mm = Eigen::Vector3d(-125.0, -123.5404569, 5.8360586);
+  farApart[1].ipp_lps_mm = Eigen::Vector3d(-125.0, -323.5404569, 10.0560586);
+  farApart[2].ipp_lps_mm = Eigen::Vector3d(-12500000.0, -123.5404569, 14.2760586);
+  auto farBytes = seriesBytes(farApart, scratch);
+  if (!farBytes) return fail(farBytes.error());
+  return writeBytes(root / "dicom_series" / "slice_positions_far_apart.bin", farBytes.value());
+}
+
 /// A 6x5x4 int16 NIfTI-1 single file (1 mm voxels, no orientation codes) whose data starts at `voxOffset`.
 std::string niftiBytes(float voxOffset) {
   std::string bytes(352 + 6 * 5 * 4 * sizeof(std::int16_t), '\0');
@@ -175,7 +242,8 @@ Status writeLoaderSeeds(const fs::path& root) {
     fs::create_directories(root / target.name, ec);
     if (ec) return fail(fmt::format("cannot create the seed folder {}: {}", (root / target.name).string(), ec.message()));
   }
-  for (Status (*write)(const fs::path&) : {writeVolumeSeeds, writeImageSeeds, writeProjectSeeds, writeBinarySeeds, writeCraftedSeeds}) {
+  for (Status (*write)(const fs::path&) : {writeVolumeSeeds, writeImageSeeds, writeProjectSeeds, writeBinarySeeds, writeCraftedSeeds,
+                                             writeDicomSeeds}) {
     if (Status written = write(root); !written) return written;
   }
   return Ok{};

@@ -1,6 +1,7 @@
 #pragma once
-// FuzzSeedWriter: the seed inputs that the project's own writers make (a small CT in every volume format, images,
-// view, pose, landmark, preset, transform, Transgraph cache and dewarp files), one folder per fuzz target.
+// FuzzSeedWriter: the seed inputs that the project's own writers make (a small CT in every volume format, DICOM CT and
+// X-ray files made with DCMTK, images, view, pose, landmark, preset, transform, Transgraph cache and dewarp files),
+// one folder per fuzz target.
 // scripts/fuzz.sh adds the seeds made from ../shared/data and by the fluoroct CLI.
 
 #include <filesystem>

@@ -5,13 +5,12 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
 #include <fstream>
-#include <functional>
 #include <numbers>
 
 #include "IO/Dicom/DicomSeriesReader.h"
+#include "SyntheticCtDicom.h"
 #include "TestSupport.h"
 
 namespace {
@@ -19,56 +18,13 @@ namespace {
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
-/// The tags of one synthetic CT slice; stored(i, j) gives the raw stored value of column i, row j.
-struct SyntheticSlice {
-  std::string seriesUid = "1.2.826.0.1.3680043.9.9999.1";
-  int cols = 5, rows = 4;
-  Vector3d ipp_lps_mm = Vector3d::Zero();
-  std::array<double, 6> iop = {1, 0, 0, 0, 1, 0};
-  bool withPixelSpacing = true, withPixelData = true;
-  double rowSpacing_mm = 0.5, columnSpacing_mm = 0.8;  // PixelSpacing = row spacing \ column spacing
-  int pixelRepresentation = 1;
-  double slope = 1.0, intercept = 0.0;
-  std::function<int(int, int)> stored = [](int i, int j) { return 10 * j + i; };
-  E_TransferSyntax transferSyntax = EXS_LittleEndianExplicit;
-};
+using fct::test::SyntheticSlice;
 
 void writeSlice(const fs::path& path, const SyntheticSlice& s) {
-  DcmFileFormat file;
-  DcmDataset* ds = file.getDataset();
-  char uid[100];
-  ds->putAndInsertString(DCM_SOPClassUID, UID_CTImageStorage);
-  ds->putAndInsertString(DCM_SOPInstanceUID, dcmGenerateUniqueIdentifier(uid, SITE_INSTANCE_UID_ROOT));
-  ds->putAndInsertString(DCM_Modality, "CT");
-  ds->putAndInsertString(DCM_SeriesInstanceUID, s.seriesUid.c_str());
-  ds->putAndInsertString(DCM_SeriesDescription, "synthetic");
-  ds->putAndInsertString(DCM_ImagePositionPatient,
-                         fmt::format("{}\\{}\\{}", s.ipp_lps_mm.x(), s.ipp_lps_mm.y(), s.ipp_lps_mm.z()).c_str());
-  ds->putAndInsertString(DCM_ImageOrientationPatient, fmt::format("{}\\{}\\{}\\{}\\{}\\{}", s.iop[0], s.iop[1],
-                                                                  s.iop[2], s.iop[3], s.iop[4], s.iop[5]).c_str());
-  if (s.withPixelSpacing) {
-    ds->putAndInsertString(DCM_PixelSpacing, fmt::format("{}\\{}", s.rowSpacing_mm, s.columnSpacing_mm).c_str());
-  }
-  ds->putAndInsertUint16(DCM_Rows, static_cast<Uint16>(s.rows));
-  ds->putAndInsertUint16(DCM_Columns, static_cast<Uint16>(s.cols));
-  ds->putAndInsertUint16(DCM_SamplesPerPixel, 1);
-  ds->putAndInsertString(DCM_PhotometricInterpretation, "MONOCHROME2");
-  ds->putAndInsertUint16(DCM_BitsAllocated, 16);
-  ds->putAndInsertUint16(DCM_BitsStored, 16);
-  ds->putAndInsertUint16(DCM_HighBit, 15);
-  ds->putAndInsertUint16(DCM_PixelRepresentation, static_cast<Uint16>(s.pixelRepresentation));
-  ds->putAndInsertString(DCM_RescaleSlope, fmt::format("{}", s.slope).c_str());
-  ds->putAndInsertString(DCM_RescaleIntercept, fmt::format("{}", s.intercept).c_str());
-  if (s.withPixelData) {
-    std::vector<Uint16> pixels;
-    for (int j = 0; j < s.rows; ++j) {
-      for (int i = 0; i < s.cols; ++i) pixels.push_back(static_cast<Uint16>(s.stored(i, j)));
-    }
-    ds->putAndInsertUint16Array(DCM_PixelData, pixels.data(), pixels.size());
-  }
+  DcmFileFormat file = s.build();
   if (s.transferSyntax != EXS_LittleEndianExplicit) {
     DcmRLEEncoderRegistration::registerCodecs();
-    ASSERT_TRUE(ds->chooseRepresentation(s.transferSyntax, nullptr).good());
+    ASSERT_TRUE(file.getDataset()->chooseRepresentation(s.transferSyntax, nullptr).good());
   }
   ASSERT_TRUE(file.saveFile(path.c_str(), s.transferSyntax).good()) << path;
 }
