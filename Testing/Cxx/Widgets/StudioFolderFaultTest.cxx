@@ -1,6 +1,7 @@
-// The case folder (CT and X-rays) disappears or changes on disk while the Studio has it open: the Studio keeps working
-// on what it loaded, and whatever reads the folder again (reopening the case or a session) shows a message naming the
-// missing or damaged file instead of crashing.
+// Disk faults while the Studio has a case open: the case folder (CT and X-rays) disappears or changes, or the disk fills
+// while it saves the session. The Studio keeps working on what it loaded; whatever reads the folder again (reopening
+// the case or a session) shows a message naming the missing or damaged file, and a failed save says why and keeps the
+// previous session file.
 #include <gtest/gtest.h>
 
 #include <QStandardPaths>
@@ -107,4 +108,25 @@ TEST_F(StudioFolderFault, ChangedFilesInTheOpenCaseFolderGiveAMessageWhenRead) {
   std::ofstream(m_case / "ct.nrrd", std::ios::binary | std::ios::trunc) << ct;
   EXPECT_FALSE(load(m_case));
   EXPECT_TRUE(m_window->lastMessage().contains(QStringLiteral("lateral.png"))) << m_window->lastMessage().toStdString();
+}
+
+TEST_F(StudioFolderFault, AFullDiskWhileSavingTheSessionKeepsThePreviousFileAndSaysWhy) {
+  const fs::path session = m_dir / "session.fctsession.json";
+  const std::string before = fct::test::readText(session);
+  keepWorking();  // the session now has a result to save
+  {
+    const fct::test::FileSizeLimit full(64);  // every write past 64 bytes fails with EFBIG, as on a full disk
+    EXPECT_FALSE(m_window->saveSessionTo(qs(session)));
+  }
+  EXPECT_TRUE(m_window->lastMessage().contains(QStringLiteral("File too large"))) << m_window->lastMessage().toStdString();
+  EXPECT_TRUE(m_window->lastMessage().contains(QStringLiteral("session.fctsession.json")));
+  EXPECT_EQ(fct::test::readText(session), before) << "the previous session file is unchanged";
+  for (const std::string& entry : fct::test::folderEntries(m_dir)) {
+    EXPECT_NE(entry.rfind(".session", 0), 0u) << "a temporary file is left: " << entry;
+  }
+  EXPECT_TRUE(m_window->document()->isModified()) << "the unsaved work is still marked unsaved";
+
+  ASSERT_TRUE(m_window->saveSessionTo(qs(session))) << m_window->lastMessage().toStdString();
+  EXPECT_NE(fct::test::readText(session), before);
+  EXPECT_FALSE(m_window->document()->isModified());
 }
