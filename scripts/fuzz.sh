@@ -3,12 +3,13 @@
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET ...]        (default 60 s; default targets: all)
 #   FCT_FUZZ_RUNS=N scripts/fuzz.sh 0 nifti                  (N executions instead of a time limit)
+#   FCT_FUZZ_JOBS=2 scripts/fuzz.sh 600                      (two targets at once, e.g. one per core)
 #
 # Installs FCT_FUZZ_PACKAGES (clang-14, libfuzzer-14-dev, dcmtk) and does the normal build (scripts/setup.sh), then
 # builds the fuzz programs with clang into build-fuzz/ (-fsanitize=fuzzer,address,undefined), makes the seed corpora
 # in build-fuzz/fuzz/seeds/<target>/ (the project's writers, the fluoroct CLI, ../shared/data in every transfer
-# syntax DCMTK writes, Testing/Fuzz/seeds and regressions), and runs the targets one after another, nice'd, each in
-# one process. New inputs collect in build-fuzz/fuzz/corpus/<target>/ (kept for the next run); a crash, leak,
+# syntax DCMTK writes, Testing/Fuzz/regressions), and runs the targets one after another (FCT_FUZZ_JOBS at
+# once), nice'd, each in one process. New inputs collect in build-fuzz/fuzz/corpus/<target>/ (kept for the next run); a crash, leak,
 # timeout or out-of-memory input is kept in build-fuzz/fuzz/crashes/<target>/ and ends that target's run.
 # Prints per target the executions and the inputs kept as crashes; exits 1 when any target crashed.
 # Reproduce a kept input: FCT_FUZZ_TARGET=<target> build-fuzz/bin/fluoroct_fuzz <file> (session: fluoroct_fuzz_studio);
@@ -54,9 +55,7 @@ seeds="$work/seeds"
 rm -rf "$seeds"
 mkdir -p "$seeds"
 QT_QPA_PLATFORM=offscreen "$FCT_BUILD/bin/fluoroct_fuzz_seeds" "$seeds"
-for kept in "$FCT_ROOT/Testing/Fuzz/seeds" "$FCT_ROOT/Testing/Fuzz/regressions"; do
-  [[ -d $kept ]] && cp -r "$kept/." "$seeds/"
-done
+cp -r "$FCT_ROOT/Testing/Fuzz/regressions/." "$seeds/"
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -125,32 +124,44 @@ if [[ -f $data/ct/pelvis_totalseg.nii.gz ]]; then
 fi
 
 # --- the runs --------------------------------------------------------------------------------------------------
-summary=()
-crashed=0
-for t in "${targets[@]}"; do
-  program="$fuzz_build/bin/fluoroct_fuzz"
+# FCT_FUZZ_JOBS targets run at once (default 1), each in one process.
+jobs=${FCT_FUZZ_JOBS:-1}
+[[ $jobs =~ ^[1-9][0-9]*$ ]] || { echo "fuzz: FCT_FUZZ_JOBS must be a whole number >= 1, got '$jobs'" >&2; exit 2; }
+run_target() {  # run_target TARGET: fuzzes it and writes its summary line to $tmp/summary-TARGET
+  local t=$1 program="$fuzz_build/bin/fluoroct_fuzz" log="$work/$1.log" status executions kept
   [[ $t == session ]] && program="$fuzz_build/bin/fluoroct_fuzz_studio"
   mkdir -p "$work/corpus/$t" "$work/crashes/$t" "$seeds/$t"
-  log="$work/$t.log"
-  limits=(-timeout=10 -rss_limit_mb=6144 -malloc_limit_mb=2048 -print_final_stats=1 -runs="$runs")
+  local limits=(-timeout=10 -rss_limit_mb=6144 -malloc_limit_mb=2048 -print_final_stats=1 -runs="$runs")
   ((seconds > 0)) && limits+=(-max_total_time="$seconds")
   echo "fuzz: $t for ${seconds}s (runs $runs) ..."
-  set +e
-  scratch=/dev/shm/fluoroct-fuzz-$$-$t  # the loaders' RAM folder; a crash leaves it behind, so it is removed here
+  local scratch=/dev/shm/fluoroct-fuzz-$$-$t  # the loaders' RAM folder; a crash leaves it behind, so it is removed here
   [[ -d /dev/shm ]] || scratch="$tmp/scratch-$t"
+  set +e
   QT_QPA_PLATFORM=offscreen FCT_FUZZ_TARGET=$t FCT_FUZZ_SCRATCH=$scratch nice -n 19 "$program" "${limits[@]}" \
     -artifact_prefix="$work/crashes/$t/" "$work/corpus/$t" "$seeds/$t" >"$log" 2>&1
   status=$?
-  rm -rf "$scratch"
   set -e
+  rm -rf "$scratch"
   executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   kept=$(find "$work/crashes/$t" -type f | wc -l)
-  ((status != 0 || kept > 0)) && crashed=1
-  summary+=("$(printf '%-18s %12s executions  %3d crash inputs kept  (exit %d, log %s)' "$t" "${executions:-?}" "$kept" \
-    "$status" "$log")")
+  printf '%-18s %12s executions  %3d crash inputs kept  (exit %d, log %s)\n' "$t" "${executions:-?}" "$kept" \
+    "$status" "$log" >"$tmp/summary-$t"
+  ((status == 0 && kept == 0)) || touch "$tmp/crashed"
+}
+running=0
+for t in "${targets[@]}"; do
+  if ((running >= jobs)); then
+    wait -n || true
+    running=$((running - 1))
+  fi
+  run_target "$t" &
+  running=$((running + 1))
 done
+wait
 echo
-echo "fuzz: $(date -u '+%Y-%m-%d %H:%M UTC'), ${seconds}s per target (runs $runs), $(nproc) cores"
-printf '%s\n' "${summary[@]}"
+echo "fuzz: $(date -u '+%Y-%m-%d %H:%M UTC'), ${seconds}s per target (runs $runs), $jobs at once, $(nproc) cores"
+for t in "${targets[@]}"; do cat "$tmp/summary-$t"; done
+crashed=0
+[[ -e $tmp/crashed ]] && crashed=1
 ((crashed == 0)) || echo "fuzz: crash inputs are in $work/crashes/<target>/"
 exit "$crashed"
