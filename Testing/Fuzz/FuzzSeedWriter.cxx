@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -22,8 +23,10 @@
 #include "IO/Xray/ImageFileWriter.h"
 #include "IO/Xray/XrayLoader.h"
 #include "Registration/RegistrationSchedule.h"
+#include "DamagedDicom.h"
 #include "SyntheticCtDicom.h"
 #include "SyntheticXrayDicom.h"
+#include "TinyTiff.h"
 
 namespace fct::fuzz {
 namespace fs = std::filesystem;
@@ -135,16 +138,23 @@ Status writeBinarySeeds(const fs::path& root) {
   return DewarpFile::write(contents, root / "dewarp" / "field.dewarp.json");
 }
 
-/// The bytes of a DICOM file as DCMTK saves the dataset (Explicit VR Little Endian), through a file beside `scratch`.
-Result<std::string> dicomBytes(DcmFileFormat& file, const fs::path& scratch) {
-  if (!file.saveFile(scratch.c_str(), EXS_LittleEndianExplicit).good()) {
+/// A DICOM file as DCMTK saves the dataset in `syntax`, as bytes, through a file beside `scratch`.
+Result<test::Bytes> savedBytes(DcmFileFormat& file, E_TransferSyntax syntax, const fs::path& scratch) {
+  if (!file.saveFile(scratch.c_str(), syntax).good()) {
     return fail(fmt::format("cannot write the DICOM seed {}", scratch.string()));
   }
   std::ifstream in(scratch, std::ios::binary);
-  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  test::Bytes bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   std::error_code ec;
   fs::remove(scratch, ec);
   return bytes;
+}
+
+/// The bytes of a DICOM file as DCMTK saves the dataset (Explicit VR Little Endian), through a file beside `scratch`.
+Result<std::string> dicomBytes(DcmFileFormat& file, const fs::path& scratch) {
+  auto bytes = savedBytes(file, EXS_LittleEndianExplicit, scratch);
+  if (!bytes) return fail(bytes.error());
+  return std::string(bytes.value().begin(), bytes.value().end());
 }
 
 /// A dicom_series input: the slices' files joined by kFileSeparator.
@@ -158,6 +168,40 @@ Result<std::string> seriesBytes(const std::vector<test::SyntheticSlice>& slices,
     joined += bytes.value();
   }
   return joined;
+}
+
+/// The inputs of the DICOM reader defects whose elements declared gigabytes in files of kilobytes: an X-ray and a CT
+/// slice in implicit VR little endian whose Pixel Data declares 4,046,797,376 bytes, and a deflated X-ray whose meta
+/// information holds an element of another group and whose dataset holds (0018,1110) with the non-standard VR 'DX'
+/// declaring 2,943,721,046 bytes.
+Status writeOverlongElementSeeds(const fs::path& root, const fs::path& scratch) {
+  const test::Bytes implicitPixelData{0xE0, 0x7F, 0x10, 0x00};
+  DcmFileFormat xray = test::SyntheticXray{}.build();
+  DcmFileFormat slice = test::SyntheticSlice{}.build();
+  for (const auto& [file, name] : {std::pair{&xray, "xray_dicom/pixel_data_longer_than_the_file.dcm"},
+                                   std::pair{&slice, "dicom_slice/pixel_data_longer_than_the_file.dcm"}}) {
+    auto bytes = savedBytes(*file, EXS_LittleEndianImplicit, scratch);
+    if (!bytes) return fail(bytes.error());
+    const std::size_t at = test::find(bytes.value(), implicitPixelData);
+    if (at >= bytes.value().size()) return fail(fmt::format("no Pixel Data in the seed {}", name));
+    test::putU32(bytes.value(), at + 4, 4046797376u);
+    if (Status written = writeBytes(root / name, std::string(bytes.value().begin(), bytes.value().end())); !written) {
+      return written;
+    }
+  }
+  auto deflated = savedBytes(xray, EXS_DeflatedLittleEndianExplicit, scratch);
+  if (!deflated) return fail(deflated.error());
+  test::Bytes stray = test::withDeflatedDatasetEdited(deflated.value(), [](test::Bytes& dataset) {
+    const std::size_t at = std::min(test::find(dataset, test::kExplicitPixelDataHeader), dataset.size());
+    test::Bytes element{0x18, 0x00, 0x10, 0x11, 'D', 'X', 0, 0, 0, 0, 0, 0};  // (0018,1110)
+    test::putU32(element, 8, 2943721046u);
+    dataset.insert(dataset.begin() + static_cast<std::ptrdiff_t>(at), element.begin(), element.end());
+  });
+  const std::size_t sopClass = test::find(stray, {0x02, 0x00, 0x02, 0x00, 'U', 'I'});
+  if (stray.empty() || sopClass >= stray.size()) return fail("cannot make the deflated seed with a stray meta element");
+  stray[sopClass] = 0x42;  // (0002,0002) becomes (0042,0002)
+  return writeBytes(root / "xray_dicom" / "deflated_unknown_vr_declares_gigabytes.dcm",
+                    std::string(stray.begin(), stray.end()));
 }
 
 /// DICOM inputs made with DCMTK: a 16x16 DX with C-arm tags, a 2-slice CT series, and the series of the loader defect
@@ -196,7 +240,9 @@ Status writeDicomSeeds(const fs::path& root) {
   farApart[2].ipp_lps_mm = Eigen::Vector3d(-12500000.0, -123.5404569, 14.2760586);
   auto farBytes = seriesBytes(farApart, scratch);
   if (!farBytes) return fail(farBytes.error());
-  return writeBytes(root / "dicom_series" / "slice_positions_far_apart.bin", farBytes.value());
+  const fs::path farPath = root / "dicom_series" / "slice_positions_far_apart.bin";
+  if (Status written = writeBytes(farPath, farBytes.value()); !written) return written;
+  return writeOverlongElementSeeds(root, scratch);
 }
 
 /// A 6x5x4 int16 NIfTI-1 single file (1 mm voxels, no orientation codes) whose data starts at `voxOffset`.
@@ -218,12 +264,13 @@ std::string niftiBytes(float voxOffset) {
 }
 
 /// Small inputs written from their description: a NIfTI seed, and the inputs of the loader defects fuzzing found
-/// (a NIfTI vox_offset beyond the file, NRRD and MetaImage sizes beyond int).
+/// (a NIfTI vox_offset beyond the file, NRRD and MetaImage sizes beyond int, a TIFF declaring 60000 x 40000 pixels).
 Status writeCraftedSeeds(const fs::path& root) {
   const std::string data(64, '\x11');
   for (const auto& [file, bytes] : std::vector<std::pair<std::string, std::string>>{
            {"nifti/int16_6x5x4.nii", niftiBytes(352.0f)},
            {"nifti/vox_offset_beyond_the_file.nii", niftiBytes(5.4e8f)},
+           {"xray_tiff/declares_60000x40000_pixels.tif", test::tinyTiff(60000, 40000, false, false)},
            {"nrrd/sizes_beyond_int.nrrd", "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
                                           "sizes: 10 8 777777777777777777777777777778\nencoding: raw\n\n" + data},
            {"mha/dimsize_beyond_int.mha", "ObjectType = Image\nNDims = 3\nBinaryData = True\nElementSpacing = 1 1 2\n"

@@ -6,7 +6,7 @@
 #include <dcmtk/dcmdata/dcuid.h>
 #include <fmt/core.h>
 
-#include "IO/Dicom/DeflatedDatasetCheck.h"
+#include "IO/Dicom/DicomElementLengthCheck.h"
 #include "IO/Dicom/DicomIdentityReader.h"
 #include "IO/Dicom/DicomValues.h"
 
@@ -67,7 +67,7 @@ Result<DicomRegistration> DicomRegistrationReader::read(const std::filesystem::p
   const std::string name = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return fail(fmt::format("registration file '{}' does not exist", name));
-  if (Status lengths = DeflatedDatasetCheck::check(path); !lengths) return fail(lengths.error());
+  if (Status lengths = DicomElementLengthCheck::check(path); !lengths) return fail(lengths.error());
   DcmFileFormat file;
   if (const OFCondition status = file.loadFile(path.c_str()); status.bad()) {
     return fail(fmt::format("'{}' is not a readable DICOM file ({})", name, status.text()));

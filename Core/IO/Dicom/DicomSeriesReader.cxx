@@ -16,7 +16,7 @@
 #include <optional>
 
 #include "IO/Dicom/DicomCodecs.h"
-#include "IO/Dicom/DeflatedDatasetCheck.h"
+#include "IO/Dicom/DicomElementLengthCheck.h"
 #include "IO/Dicom/DicomIdentityReader.h"
 #include "IO/Dicom/SliceStack.h"
 
@@ -94,7 +94,7 @@ std::optional<int> getUint16(DcmDataset& ds, const DcmTagKey& key) {
 
 /// Parses the header of a DICOM file (pixel data is left on disk). Error when a Part 10 file cannot be parsed.
 Result<SliceHeader> readHeader(const fs::path& path) {
-  if (Status lengths = DeflatedDatasetCheck::check(path); !lengths) return fail(lengths.error());
+  if (Status lengths = DicomElementLengthCheck::check(path); !lengths) return fail(lengths.error());
   DcmFileFormat file;
   const OFCondition status = file.loadFile(path.c_str(), EXS_Unknown, EGL_noChange, 1024);
   if (status.bad()) {
@@ -279,7 +279,7 @@ void storedToHu(const Raw* raw, std::size_t count, const SliceHeader& h, float* 
 
 /// Reads and decodes one slice's pixel data into hu (rows × cols floats). Errors name the file.
 Status decodeSlice(const SliceHeader& h, float* hu) {
-  if (Status lengths = DeflatedDatasetCheck::check(h.path); !lengths) return lengths;
+  if (Status lengths = DicomElementLengthCheck::check(h.path); !lengths) return lengths;
   DcmFileFormat file;
   OFCondition status = file.loadFile(h.path.c_str());
   if (status.bad()) {

@@ -14,7 +14,7 @@
 #include <cstring>
 
 #include "IO/Dicom/DicomCodecs.h"
-#include "IO/Dicom/DeflatedDatasetCheck.h"
+#include "IO/Dicom/DicomElementLengthCheck.h"
 #include "IO/Dicom/DicomIdentityReader.h"
 #include "IO/Dicom/DicomValues.h"
 
@@ -48,7 +48,7 @@ Status loadAndValidate(const std::filesystem::path& path, int frame, LoadedFile&
   const std::string name = path.filename().string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return fail(fmt::format("X-ray file '{}' does not exist", path.string()));
-  if (Status lengths = DeflatedDatasetCheck::check(path); !lengths) return lengths;
+  if (Status lengths = DicomElementLengthCheck::check(path); !lengths) return lengths;
   const OFCondition status = loaded.file.loadFile(path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength, ERM_autoDetect);
   if (status.bad()) {
     return fail(fmt::format("'{}' is not a readable DICOM file ({}); it may be truncated or not DICOM at all", name,

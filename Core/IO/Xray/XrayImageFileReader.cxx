@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -28,6 +30,64 @@ bool hasSignature(const std::filesystem::path& path, const std::string& modality
     if (first4 == std::string(tiff, 4)) return true;
   }
   return false;
+}
+
+/// The largest image FluoroCT decodes: more than any X-ray detector (a 43 cm flat panel at 0.1 mm is 4300 pixels a
+/// side). OpenCV allocates the whole image its header declares before it decodes a byte, so a damaged header would
+/// otherwise ask for gigabytes.
+constexpr std::uint64_t kMaxImageSide = 16384;
+constexpr std::uint64_t kMaxImagePixels = std::uint64_t{1} << 25;  // 33.5 million: 5792 x 5792
+
+/// Width and height in pixels as an image file's header declares them.
+struct DeclaredSize {
+  std::uint64_t cols = 0, rows = 0;
+};
+
+/// Reads an unsigned integer of `bytes` bytes (1 to 8) at `offset`, in the file's byte order; nullopt past the end.
+std::optional<std::uint64_t> readUnsigned(std::ifstream& file, std::uint64_t offset, int bytes, bool bigEndian) {
+  unsigned char b[8] = {};
+  file.clear();
+  file.seekg(static_cast<std::streamoff>(offset));
+  if (!file.read(reinterpret_cast<char*>(b), bytes)) return std::nullopt;
+  std::uint64_t value = 0;
+  for (int i = 0; i < bytes; ++i) value |= std::uint64_t{b[bigEndian ? bytes - 1 - i : i]} << (8 * i);
+  return value;
+}
+
+/// The size in the IHDR chunk of a PNG (big-endian width and height at bytes 16 and 20).
+std::optional<DeclaredSize> pngDeclaredSize(std::ifstream& file) {
+  const auto cols = readUnsigned(file, 16, 4, true), rows = readUnsigned(file, 20, 4, true);
+  if (!cols || !rows) return std::nullopt;
+  return DeclaredSize{*cols, *rows};
+}
+
+/// The ImageWidth (256) and ImageLength (257) of a TIFF's first directory, classic or BigTIFF; nullopt when the
+/// directory cannot be read or lacks either tag (OpenCV then reports the file itself).
+std::optional<DeclaredSize> tiffDeclaredSize(std::ifstream& file) {
+  const auto order = readUnsigned(file, 0, 2, false), version = readUnsigned(file, 2, 2, false);
+  if (!order || !version) return std::nullopt;
+  const bool big = *order == 0x4D4D;  // "MM"
+  const bool bigTiff = readUnsigned(file, 2, 2, big) == 43u;
+  // Classic: a 4-byte directory offset, a 2-byte entry count, 12-byte entries (tag, type, 4-byte count, 4-byte value);
+  // BigTIFF: 8, 8 and 20 (8-byte count and value).
+  const int offsetBytes = bigTiff ? 8 : 4, countBytes = bigTiff ? 8 : 2, entryBytes = bigTiff ? 20 : 12;
+  const auto directory = readUnsigned(file, bigTiff ? 8 : 4, offsetBytes, big);
+  if (!directory) return std::nullopt;
+  const auto entries = readUnsigned(file, *directory, countBytes, big);
+  if (!entries) return std::nullopt;
+  std::optional<std::uint64_t> cols, rows;
+  for (std::uint64_t i = 0; i < std::min<std::uint64_t>(*entries, 4096) && !(cols && rows); ++i) {
+    const std::uint64_t entry = *directory + countBytes + i * entryBytes;
+    const auto tag = readUnsigned(file, entry, 2, big), type = readUnsigned(file, entry + 2, 2, big);
+    if (!tag || !type) return std::nullopt;
+    if (*tag != 256 && *tag != 257) continue;
+    const int valueBytes = *type == 3 ? 2 : *type == 4 ? 4 : *type == 16 ? 8 : 0;  // SHORT, LONG, LONG8
+    if (valueBytes == 0) continue;
+    const auto value = readUnsigned(file, entry + 4 + offsetBytes, valueBytes, big);
+    (*tag == 256 ? cols : rows) = value;
+  }
+  if (!cols || !rows) return std::nullopt;
+  return DeclaredSize{*cols, *rows};
 }
 
 /// True when every pixel has equal B, G and R values (a grey image stored as colour).
@@ -59,6 +119,13 @@ Result<XrayImage> XrayImageFileReader::read(const std::filesystem::path& path) {
     return fail(fmt::format("'{}' is not a {} file: it does not start with the {} signature (damaged, or another format "
                             "under a .{} name)",
                             path.filename().string(), modality, modality, extension.substr(1)));
+  }
+  std::ifstream header(path, std::ios::binary);
+  if (const auto size = modality == "PNG" ? pngDeclaredSize(header) : tiffDeclaredSize(header);
+      size && (size->cols > kMaxImageSide || size->rows > kMaxImageSide || size->cols * size->rows > kMaxImagePixels)) {
+    return fail(fmt::format("'{}' declares an image of {} x {} pixels; FluoroCT reads X-ray images of at most {} pixels "
+                            "a side and {} pixels in all (a damaged file, or not an X-ray image?)",
+                            path.filename().string(), size->cols, size->rows, kMaxImageSide, kMaxImagePixels));
   }
   std::vector<std::string> warnings;
   cv::Mat grey;

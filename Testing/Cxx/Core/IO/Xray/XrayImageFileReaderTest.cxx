@@ -1,13 +1,19 @@
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "IO/Xray/XrayImageFileReader.h"
 #include "TestSupport.h"
+#include "TinyTiff.h"
 
 using fct::XrayImageFileReader;
+using fct::test::put;
+using fct::test::tinyTiff;
 
 namespace {
 
@@ -119,4 +125,43 @@ TEST(XrayImageFileReader, RejectsAFileWhoseBytesAreNotItsFormat) {
   ASSERT_FALSE(tif);
   EXPECT_NE(tif.error().find("is not a TIFF file"), std::string::npos) << tif.error();
   EXPECT_TRUE(XrayImageFileReader::read(dir / "real.png").ok());
+}
+
+TEST(XrayImageFileReader, RefusesAnImageWhoseHeaderDeclaresMoreThanAnyDetectorBeforeDecodingIt) {
+  // OpenCV allocates the image its header declares before it decodes: a 900-byte TIFF once asked for over 2 GB.
+  const auto dir = fct::test::scratchDir();
+  for (const bool bigEndian : {false, true}) {
+    for (const bool bigTiff : {false, true}) {
+      const std::string name = std::string(bigEndian ? "mm" : "ii") + (bigTiff ? "_bigtiff" : "_classic");
+      std::ofstream(dir / (name + ".tif"), std::ios::binary) << tinyTiff(2, 2, bigEndian, bigTiff);
+      const auto small = XrayImageFileReader::read(dir / (name + ".tif"));
+      ASSERT_TRUE(small.ok()) << name << ": " << small.error();
+      EXPECT_EQ(small.value().cols, 2);
+      EXPECT_EQ(small.value().rows, 2);
+      EXPECT_EQ(small.value().at(1, 1), 50.0f) << name;
+
+      std::ofstream(dir / (name + "_huge.tif"), std::ios::binary) << tinyTiff(60000, 40000, bigEndian, bigTiff);
+      const auto huge = XrayImageFileReader::read(dir / (name + "_huge.tif"));
+      ASSERT_FALSE(huge.ok()) << name;
+      EXPECT_NE(huge.error().find("declares an image of 60000 x 40000 pixels"), std::string::npos) << huge.error();
+    }
+  }
+  // Each side within the limit, the whole beyond it: 16000 x 16000 is 256 million pixels.
+  std::ofstream(dir / "square.tif", std::ios::binary) << tinyTiff(16000, 16000, false, false);
+  const auto square = XrayImageFileReader::read(dir / "square.tif");
+  ASSERT_FALSE(square.ok());
+  EXPECT_NE(square.error().find("16000 x 16000"), std::string::npos) << square.error();
+
+  // A PNG: width and height are the first fields of its IHDR chunk (bytes 16 to 23, big-endian).
+  ASSERT_TRUE(cv::imwrite((dir / "small.png").string(), cv::Mat(3, 5, CV_8U, cv::Scalar(9))));
+  std::ifstream in(dir / "small.png", std::ios::binary);
+  std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string size;
+  put(size, 70000, 4, true);
+  put(size, 3, 4, true);
+  png.replace(16, 8, size);
+  std::ofstream(dir / "wide.png", std::ios::binary) << png;
+  const auto wide = XrayImageFileReader::read(dir / "wide.png");
+  ASSERT_FALSE(wide.ok());
+  EXPECT_NE(wide.error().find("'wide.png' declares an image of 70000 x 3 pixels"), std::string::npos) << wide.error();
 }
