@@ -54,6 +54,7 @@ struct Options {
   double metalMinExcess = MetalMaskOptions{}.minExcess;
   double cutFaceMargin_mm = RegistrationCaseOptions{}.cutFaceMargin_mm;
   double rayCastStep_mm = DrrRendererOptions{}.rayCastStep_mm;
+  bool rayCastStepGiven = false;  ///< --raycast-step-mm was on the command line (it only applies to --method raycast)
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
   std::string dicomReg;  ///< optional DICOM Spatial Registration object (REG) of the final pose
   RegistrationAblation ablation;
@@ -93,6 +94,11 @@ Result<Inputs> readInputs(const Options& o) {
   auto method = DrrRendererFactory::parseMethod(o.method);
   if (!method) return fail("--method: " + method.error());
   in.method = method.value();
+  if (o.rayCastStepGiven && in.method != DrrMethod::RayCast) {
+    return fail(fmt::format("--raycast-step-mm sets the sampling step of --method raycast; it has no effect with "
+                            "--method {}: drop it, or add --method raycast",
+                            o.method));
+  }
   auto schedule = RegistrationSchedule::resolve(o.preset);
   if (!schedule) return fail("--preset: " + schedule.error());
   in.schedule = std::move(schedule).value();
@@ -446,7 +452,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                       "DRR method: siddon (exact), raycast (trilinear) or transgraph (one precomputed ray table per "
                       "view around the initial pose, cached on disk; rays outside it are exact)")
       ->capture_default_str();
-  command->add_option("--raycast-step-mm", options->rayCastStep_mm,
+  auto* rayCastStep = command->add_option("--raycast-step-mm", options->rayCastStep_mm,
                       "raycast method: sampling step along each ray in mm; 0 = half the smallest voxel spacing")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
@@ -509,7 +515,10 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                     "Exact DRRs of coarse pyramid levels integrate the full CT instead of one box-averaged to the "
                     "level's pixel size at the bone");
   addModuleXmlFlag(command, registerModuleXml());
-  command->callback([&action, options] { action = [options] { return runRegister(*options); }; });
+  command->callback([&action, options, rayCastStep] {
+    options->rayCastStepGiven = rayCastStep->count() > 0;
+    action = [options] { return runRegister(*options); };
+  });
 }
 
 }  // namespace fct::cli

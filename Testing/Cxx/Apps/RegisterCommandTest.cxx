@@ -233,6 +233,10 @@ TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
   const auto badStep = fct::test::runCli(base + init + " --method raycast --raycast-step-mm -1");
   EXPECT_TRUE(oneErrorLine(badStep)) << badStep.err;
   EXPECT_NE(badStep.err.find("--raycast-step-mm"), std::string::npos) << badStep.err;
+  // The step of trilinear sampling means nothing to the exact renderer: refused, not silently ignored.
+  const auto stepWithSiddon = fct::test::runCli(base + init + " --raycast-step-mm 3");
+  EXPECT_TRUE(oneErrorLine(stepWithSiddon)) << stepWithSiddon.err;
+  EXPECT_NE(stepWithSiddon.err.find("it has no effect with --method siddon"), std::string::npos) << stepWithSiddon.err;
 
   const auto badMetal = fct::test::runCli(base + init + " --metal-min-excess 0");
   EXPECT_TRUE(oneErrorLine(badMetal)) << badMetal.err;
