@@ -37,22 +37,22 @@ std::uint32_t u32(const std::uint8_t* p, bool bigEndian) {
   return bigEndian ? (first << 16) | second : first | (second << 16);
 }
 
+/// The VR named by the two bytes at p, as DCMTK's DcmVR reads it (an unknown name included).
+DcmVR vrAt(const std::uint8_t* p) {
+  const char name[3] = {static_cast<char>(p[0]), static_cast<char>(p[1]), '\0'};
+  return DcmVR(name);
+}
+
 /// True when the two bytes name a VR whose explicit encoding has two reserved bytes and a 32-bit length, as DCMTK
 /// decides it (an unknown VR included: DCMTK then assumes the form its DcmVR gives).
-bool hasLongLength(const std::uint8_t* vr) {
-  const char name[3] = {static_cast<char>(vr[0]), static_cast<char>(vr[1]), '\0'};
-  return DcmVR(name).usesExtendedLengthEncoding();
-}
+bool hasLongLength(const std::uint8_t* vr) { return vrAt(vr).usesExtendedLengthEncoding(); }
 
 /// The encoding DCMTK guesses for a dataset without a (known) transfer syntax, from its first six bytes
 /// (`DcmItem::checkTransferSyntax`): a VR in bytes 4-5 means explicit; a tag known only when byte-swapped, or a group
 /// above 0x00FF that is at most 0x00FF swapped, means big endian.
 Encoding guessedEncoding(const std::uint8_t* first6) {
-  const char vrName[3] = {static_cast<char>(first6[4]), static_cast<char>(first6[5]), '\0'};
-  const bool isAlpha = std::isalpha(first6[4]) && std::isalpha(first6[5]);
-  const bool explicitVr = isAlpha && DcmVR(vrName).isStandard();
-  const std::uint16_t group = u16(first6, false), element = u16(first6 + 2, false);
-  const DcmTag little(group, element), big(u16(first6, true), u16(first6 + 2, true));
+  const bool explicitVr = std::isalpha(first6[4]) && std::isalpha(first6[5]) && vrAt(first6 + 4).isStandard();
+  const DcmTag little(u16(first6, false), u16(first6 + 2, false)), big(u16(first6, true), u16(first6 + 2, true));
   const bool littleKnown = little.error().good(), bigKnown = big.error().good();
   bool bigEndian = false;
   if (littleKnown || bigKnown) {
@@ -61,10 +61,11 @@ Encoding guessedEncoding(const std::uint8_t* first6) {
   return Encoding{explicitVr, bigEndian};
 }
 
-/// A dataset's bytes read from the file itself, skipping values without reading them.
+/// A dataset's bytes read from the open file itself, skipping values without reading them.
 class FileBytes {
  public:
-  FileBytes(const std::filesystem::path& path, std::uint64_t offset) : m_file(path, std::ios::binary) {
+  FileBytes(std::ifstream& file, std::uint64_t offset) : m_file(file) {
+    m_file.clear();
     m_file.seekg(static_cast<std::streamoff>(offset));
   }
   /// Copies up to n bytes to out (or skips them when out is null); returns how many there were.
@@ -78,7 +79,7 @@ class FileBytes {
   }
 
  private:
-  std::ifstream m_file;
+  std::ifstream& m_file;
 };
 
 /// The raw deflate stream (no zlib header) of a Deflated transfer syntax file, inflated a little at a time.
@@ -216,11 +217,13 @@ Status DicomElementLengthCheck::check(const std::filesystem::path& path) {
     const std::uint32_t length =
         headerBytes == 12 ? u32(bytes.data() + pos + 8, false) : u16(bytes.data() + pos + 6, false);
     if (length > bytes.size() - pos - headerBytes) {  // beyond the file, or a meta information over 64 kB
+      const std::uint64_t follow = fileBytes - pos - headerBytes;
       return fail(fmt::format("'{}' is a damaged DICOM file: element ({:04X},{:04X}) at byte {} of its file meta "
-                              "information declares {} bytes, but only {} follow{} (truncated or corrupt file?)",
+                              "information declares {} bytes, {} (truncated or corrupt file?)",
                               name, u16(bytes.data() + pos, false), u16(bytes.data() + pos + 2, false), pos, length,
-                              fileBytes - pos - headerBytes,
-                              length > fileBytes - pos - headerBytes ? "" : " in the first 64 kB of the file"));
+                              length > follow ? fmt::format("but only {} follow", follow)
+                                              : fmt::format("more than the {} kB a file meta information can hold",
+                                                            kMetaBytesRead / 1024)));
     }
     if (u32(bytes.data() + pos, false) == 0x00100002u) {
       syntax.assign(reinterpret_cast<const char*>(bytes.data() + pos + headerBytes), length);
@@ -234,7 +237,7 @@ Status DicomElementLengthCheck::check(const std::filesystem::path& path) {
   const Encoding encoding = known ? Encoding{xfer.isExplicitVR(), xfer.isBigEndian()} : guessedEncoding(&bytes[pos]);
 
   if (!known || xfer.getStreamCompression() != ESC_zlib) {
-    FileBytes dataset(path, pos);
+    FileBytes dataset(in, pos);
     const std::string problem = firstOverlongElement(dataset, fileBytes - pos, encoding, pos, "the file");
     if (problem.empty()) return Ok{};
     if (!part10) {

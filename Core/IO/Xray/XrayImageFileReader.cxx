@@ -19,8 +19,7 @@ namespace {
 /// True when the file starts with the signature of its format (PNG: 89 'PNG' 0D 0A 1A 0A; TIFF: "II*\0", "MM\0*", or
 /// BigTIFF "II+\0", "MM\0+"). OpenCV picks its decoder from the content, not the name: without this check a file
 /// named .png holding, say, DICOM bytes reaches a decoder (GDCM) that aborts the program on damaged input.
-bool hasSignature(const std::filesystem::path& path, const std::string& modality) {
-  std::ifstream file(path, std::ios::binary);
+bool hasSignature(std::ifstream& file, const std::string& modality) {
   char head[8] = {};
   file.read(head, sizeof head);
   const std::string bytes(head, static_cast<std::size_t>(file.gcount()));
@@ -64,10 +63,10 @@ std::optional<DeclaredSize> pngDeclaredSize(std::ifstream& file) {
 /// The ImageWidth (256) and ImageLength (257) of a TIFF's first directory, classic or BigTIFF; nullopt when the
 /// directory cannot be read or lacks either tag (OpenCV then reports the file itself).
 std::optional<DeclaredSize> tiffDeclaredSize(std::ifstream& file) {
-  const auto order = readUnsigned(file, 0, 2, false), version = readUnsigned(file, 2, 2, false);
-  if (!order || !version) return std::nullopt;
+  const auto order = readUnsigned(file, 0, 2, false);
+  if (!order) return std::nullopt;
   const bool big = *order == 0x4D4D;  // "MM"
-  const bool bigTiff = readUnsigned(file, 2, 2, big) == 43u;
+  const bool bigTiff = readUnsigned(file, 2, 2, big) == 43u;  // 42: classic (hasSignature checked it is one of the two)
   // Classic: a 4-byte directory offset, a 2-byte entry count, 12-byte entries (tag, type, 4-byte count, 4-byte value);
   // BigTIFF: 8, 8 and 20 (8-byte count and value).
   const int offsetBytes = bigTiff ? 8 : 4, countBytes = bigTiff ? 8 : 2, entryBytes = bigTiff ? 20 : 12;
@@ -115,12 +114,12 @@ Result<XrayImage> XrayImageFileReader::read(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return fail(fmt::format("X-ray file '{}' does not exist", path.string()));
 
-  if (!hasSignature(path, modality)) {
+  std::ifstream header(path, std::ios::binary);
+  if (!hasSignature(header, modality)) {
     return fail(fmt::format("'{}' is not a {} file: it does not start with the {} signature (damaged, or another format "
                             "under a .{} name)",
                             path.filename().string(), modality, modality, extension.substr(1)));
   }
-  std::ifstream header(path, std::ios::binary);
   if (const auto size = modality == "PNG" ? pngDeclaredSize(header) : tiffDeclaredSize(header);
       size && (size->cols > kMaxImageSide || size->rows > kMaxImageSide || size->cols * size->rows > kMaxImagePixels)) {
     return fail(fmt::format("'{}' declares an image of {} x {} pixels; FluoroCT reads X-ray images of at most {} pixels "
