@@ -108,12 +108,12 @@ int runDrr(const DrrCommandOptions& options) {
     T_world_from_ct = pose.value();
   }
 
-  const auto ct = CtLoader::load(options.ct);
+  auto ct = CtLoader::load(options.ct);
   if (!ct.ok()) return reportError(ct.error());
   printWarnings(ct.warnings());
   DrrValueOptions valueOptions;
   valueOptions.kind = valueKind.value();
-  auto drrVolume = DrrVolume::create(ct.value(), valueOptions);
+  auto drrVolume = DrrVolume::create(std::move(ct).value(), valueOptions);  // the HU values are not needed after
   if (!drrVolume.ok()) return reportError(drrVolume.error());
   DrrRendererOptions rendererOptions;
   rendererOptions.method = method.value();

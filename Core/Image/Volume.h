@@ -25,6 +25,11 @@ class Volume {
                                const Eigen::Vector3d& origin_lps_mm = Eigen::Vector3d::Zero(),
                                const Eigen::Matrix3d& direction_lps = Eigen::Matrix3d::Identity(),
                                float fill_value = 0.0f);
+  /// A volume that takes over `voxels` (dims.x*dims.y*dims.z values, i fastest) instead of allocating: the same
+  /// geometry checks as create(), and an error when the count does not match dims.
+  static Result<Volume> fromVoxels(const Eigen::Vector3i& dims, const Eigen::Vector3d& spacing_mm,
+                                   const Eigen::Vector3d& origin_lps_mm, const Eigen::Matrix3d& direction_lps,
+                                   std::vector<float> voxels);
 
   /// Number of voxels along i, j, k.
   const Eigen::Vector3i& dims() const { return m_dims; }
@@ -60,7 +65,7 @@ class Volume {
   const std::vector<float>& voxels() const { return m_voxels; }
   std::vector<float>& voxels() { return m_voxels; }
 
-  /// Minimum and maximum voxel value (0,0 for an empty volume).
+  /// Minimum and maximum voxel value (0,0 for an empty volume; NaN voxels are skipped).
   std::pair<float, float> valueRange() const;
 
   /// Free-text provenance: file or series read, resampling done, original scalar type.
@@ -69,6 +74,10 @@ class Volume {
   std::optional<DicomIdentity> dicom;
 
  private:
+  /// The geometry checks of create() and fromVoxels(); the error says what is wrong.
+  static Status checkGeometry(const Eigen::Vector3i& dims, const Eigen::Vector3d& spacing_mm,
+                              const Eigen::Vector3d& origin_lps_mm, const Eigen::Matrix3d& direction_lps);
+
   Eigen::Vector3i m_dims = Eigen::Vector3i::Zero();
   Eigen::Vector3d m_spacing_mm = Eigen::Vector3d::Ones();
   Eigen::Vector3d m_origin_lps_mm = Eigen::Vector3d::Zero();

@@ -10,35 +10,63 @@
 #include <functional>
 #include <limits>
 
+#include "Base/LargePages.h"
 #include "Base/NameTable.h"
 
 namespace fct {
 
-Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& options) {
+Result<DrrVolume> DrrVolume::prepare(const Volume& ct, const DrrValueOptions& options) {
   if (ct.voxelCount() == 0) return fail("the CT volume is empty; load a CT before rendering DRRs");
   if (options.kind == DrrValueKind::Attenuation &&
       (!std::isfinite(options.waterAttenuation_per_mm) || options.waterAttenuation_per_mm <= 0.0)) {
     return fail(fmt::format("water attenuation must be positive and finite, got {} /mm", options.waterAttenuation_per_mm));
   }
   DrrVolume volume;
-  volume.m_values = ct;
   volume.m_options = options;
   volume.m_T_ct_from_ijk = ct.T_lps_from_ijk();
   volume.m_T_ijk_from_ct = ct.T_ijk_from_lps();
+  return volume;
+}
 
-  std::vector<float>& voxels = volume.m_values.voxels();
-  const float mu_water = static_cast<float>(options.waterAttenuation_per_mm);
-  const bool attenuation = options.kind == DrrValueKind::Attenuation;
+Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& options) {
+  auto volume = prepare(ct, options);
+  if (!volume) return volume;
+  // A fresh large-page grid of the CT's geometry, filled by the parallel conversion (no serial copy of the CT).
+  auto grid = Volume::create(ct.dims(), ct.spacing_mm(), ct.origin_lps_mm(), ct.direction_lps());
+  if (!grid) return fail(grid.error());
+  volume.value().m_values = std::move(grid).value();
+  volume.value().m_values.description = ct.description;
+  volume.value().m_values.dicom = ct.dicom;
+  if (Status converted = volume.value().convertFrom(ct.voxels()); !converted) return fail(converted.error());
+  return volume;
+}
+
+Result<DrrVolume> DrrVolume::create(Volume&& ct, const DrrValueOptions& options) {
+  auto volume = prepare(ct, options);
+  if (!volume) return volume;
+  volume.value().m_values = std::move(ct);
+  const std::vector<float>& inPlace = volume.value().m_values.voxels();
+  if (Status converted = volume.value().convertFrom(inPlace); !converted) return fail(converted.error());
+  return volume;
+}
+
+Status DrrVolume::convertFrom(const std::vector<float>& hu) {
+  std::vector<float>& voxels = m_values.voxels();
+  const float mu_water = static_cast<float>(m_options.waterAttenuation_per_mm);
+  const bool attenuation = m_options.kind == DrrValueKind::Attenuation;
+  // Each voxel is read before it is written, so `hu` may be `voxels` itself.
   const std::size_t nonFinite = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, voxels.size(), 1 << 16), std::size_t{0},
       [&](const tbb::blocked_range<std::size_t>& range, std::size_t count) {
         for (std::size_t n = range.begin(); n != range.end(); ++n) {
-          const float value = voxels[n];
+          const float value = hu[n];
           if (!std::isfinite(value)) {
             ++count;
             voxels[n] = 0.0f;
           } else if (attenuation) {
             voxels[n] = value <= -1000.0f ? 0.0f : mu_water * (1.0f + value * 0.001f);
+          } else {
+            voxels[n] = value;
           }
         }
         return count;
@@ -47,8 +75,8 @@ Result<DrrVolume> DrrVolume::create(const Volume& ct, const DrrValueOptions& opt
   if (nonFinite > 0) {
     return fail(fmt::format("the CT has {} voxels that are NaN or infinite; repair or re-export the volume", nonFinite));
   }
-  volume.findContentBox();
-  return volume;
+  findContentBox();
+  return Ok{};
 }
 
 Result<DrrVolume> DrrVolume::coarsened(const Eigen::Vector3i& blockSize_ijk) const {
@@ -80,6 +108,28 @@ Result<DrrVolume> DrrVolume::coarsened(const Eigen::Vector3i& blockSize_ijk) con
   });
   volume.findContentBox();
   return volume;
+}
+
+const std::vector<float>& DrrVolume::valuesJFastest() const {
+  std::call_once(m_jFastest->made, [this] {
+    const Eigen::Vector3i& n = dims();
+    assignWithLargePages(m_jFastest->values, m_values.voxelCount(), 0.0f);
+    const float* source = data();
+    float* target = m_jFastest->values.data();
+    constexpr int kBlock = 16;  // i values per task: one cache line of each source row
+    const int blocks = (n.x() + kBlock - 1) / kBlock;
+    tbb::parallel_for(tbb::blocked_range<int>(0, n.z() * blocks), [&](const tbb::blocked_range<int>& tasks) {
+      for (int task = tasks.begin(); task != tasks.end(); ++task) {
+        const int k = task / blocks;
+        const int i0 = (task - k * blocks) * kBlock, i1 = std::min(n.x(), i0 + kBlock);
+        for (int j = 0; j < n.y(); ++j) {
+          const float* row = source + m_values.offset(0, j, k);
+          for (int i = i0; i < i1; ++i) target[j + n.y() * (i + static_cast<std::ptrdiff_t>(n.x()) * k)] = row[i];
+        }
+      }
+    });
+  });
+  return m_jFastest->values;
 }
 
 void DrrVolume::findContentBox() {

@@ -4,7 +4,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <memory>
+#include <mutex>
 #include <string_view>
+#include <vector>
 
 #include "Base/Result.h"
 #include "Image/Volume.h"
@@ -35,8 +38,11 @@ class DrrVolume {
  public:
   DrrVolume() = default;
 
-  /// Converts a CT once. Fails on an empty volume, non-finite voxels, or a non-positive or non-finite µ_water.
+  /// Converts a CT once into a new grid. Fails on an empty volume, non-finite voxels, or a non-positive or non-finite
+  /// µ_water.
   static Result<DrrVolume> create(const Volume& ct, const DrrValueOptions& options = {});
+  /// As above, converting the CT's own voxels in place (no second copy of a large CT); `ct` is consumed.
+  static Result<DrrVolume> create(Volume&& ct, const DrrValueOptions& options = {});
 
   /// The values box-averaged over blocks of blockSize_ijk voxels (each >= 1): coarse voxel (I,J,K) is the mean of
   /// voxels [I·b, I·b + b - 1] per axis, where voxels beyond the volume count as 0 (air for attenuation values), so
@@ -58,6 +64,10 @@ class DrrVolume {
   const Eigen::Vector3i& dims() const { return m_values.dims(); }
   /// Contiguous voxel values, i fastest, then j, then k.
   const float* data() const { return m_values.voxels().data(); }
+  /// The same values with j fastest, then i, then k (value (i,j,k) at j + nj·(i + ni·k)): the layout in which rays
+  /// running along i read neighbouring j contiguously (SiddonRayCaster's packets). Made on the first call (one more
+  /// copy of the values in memory), then shared by every renderer and copy of this volume; thread-safe.
+  const std::vector<float>& valuesJFastest() const;
   /// Map from CT physical mm (LPS) to continuous voxel index.
   const Eigen::Affine3d& T_ijk_from_ct() const { return m_T_ijk_from_ct; }
   /// Map from continuous voxel index to CT physical mm (LPS).
@@ -75,10 +85,22 @@ class DrrVolume {
   Eigen::Vector3d contentBoxMax_ijk() const { return m_contentLast_ijk.cast<double>().array() + 0.5; }
 
  private:
+  /// Checks the options and sets everything but the values from `ct`'s geometry; the error says what is wrong.
+  static Result<DrrVolume> prepare(const Volume& ct, const DrrValueOptions& options);
+  /// Writes the DRR value of every voxel of `hu` (the CT's values; may be the values' own storage) into the values,
+  /// then finds the content box. Fails on non-finite voxels.
+  Status convertFrom(const std::vector<float>& hu);
   /// Sets the content box from the values.
   void findContentBox();
 
+  /// The j-fastest copy, made once on demand.
+  struct JFastestCopy {
+    std::once_flag made;
+    std::vector<float> values;
+  };
+
   Volume m_values;
+  std::shared_ptr<JFastestCopy> m_jFastest = std::make_shared<JFastestCopy>();
   DrrValueOptions m_options;
   Eigen::Affine3d m_T_ijk_from_ct = Eigen::Affine3d::Identity();
   Eigen::Affine3d m_T_ct_from_ijk = Eigen::Affine3d::Identity();

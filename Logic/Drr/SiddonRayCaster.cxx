@@ -6,6 +6,9 @@
 #include <cstdlib>
 #include <limits>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "Drr/DrrRayGeometry.h"
 
 namespace fct {
@@ -14,9 +17,109 @@ namespace {
 /// Rays whose dominant axis has at least this many boundaries per boundary of the other two are traversed in runs
 /// (callgrind on the pelvis CT: runs cost more instructions than single steps below about 2 boundaries per run).
 constexpr long kMinRunLength = 3;
+
+/// The index axis (0 = i, 1 = j, 2 = k) along which `d` has the largest component; the first on a tie.
+int dominantAxis(const Eigen::Vector3d& d) {
+  int axis = std::abs(d.y()) > std::abs(d.x()) ? 1 : 0;
+  if (std::abs(d.z()) > std::abs(d[axis])) axis = 2;
+  return axis;
+}
+
+/// Up to SiddonPacketKernel::kLanes consecutive pixels of one detector row whose rays share their dominant axis.
+struct RayPacket {
+  std::size_t first = 0;  ///< position of the first pixel in the render's pixel list
+  int count = 0;
+  int axis = 0;
+};
 }  // namespace
 
-SiddonRayCaster::SiddonRayCaster(std::shared_ptr<const DrrVolume> volume) : IndexSpaceRayCaster(std::move(volume)) {}
+SiddonRayCaster::SiddonRayCaster(std::shared_ptr<const DrrVolume> volume, SiddonTraversal traversal)
+    : IndexSpaceRayCaster(std::move(volume)),
+      m_packets(traversal == SiddonTraversal::Fastest && SiddonPacketKernel::available()) {}
+
+SiddonPacketLayout SiddonRayCaster::packetLayout(int axis) const {
+  const DrrVolume& vol = volume();
+  const Eigen::Vector3i& n = vol.dims();
+  const std::ptrdiff_t slice = static_cast<std::ptrdiff_t>(n.x()) * n.y();
+  if (axis == 1) return {vol.data(), n.y(), n.x(), n.z(), n.x(), slice};
+  if (axis == 2) return {vol.data(), n.z(), n.x(), n.y(), slice, n.x()};
+  return {vol.valuesJFastest().data(), n.x(), n.y(), n.z(), n.y(), slice};
+}
+
+DrrRenderStats SiddonRayCaster::integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct,
+                                                const std::int32_t* pixels, std::size_t count, float* values) const {
+  if (!m_packets) return IndexSpaceRayCaster::integratePixels(levelCamera, T_world_from_ct, pixels, count, values);
+  const DrrVolume& vol = volume();
+  const DrrRayGeometry geometry(levelCamera, T_world_from_ct, vol.T_ijk_from_ct());
+  const Eigen::Vector3d& source_ijk = geometry.source_ijk();
+  const int cols = geometry.cols();
+  const auto pixelAt = [&](std::size_t n) { return pixels ? static_cast<std::int64_t>(pixels[n]) : static_cast<std::int64_t>(n); };
+
+  // Packets are formed from the pixel list alone (not from the threads' share of it), and each ray is integrated
+  // along its own dominant axis, so a pixel's value does not depend on the list or the thread count.
+  std::vector<RayPacket> packets;
+  packets.reserve(count / 8 + 1);
+  std::int64_t previous = -2;
+  bool alongI = false;
+  for (std::size_t n = 0; n < count; ++n) {
+    const std::int64_t index = pixelAt(n);
+    const int row = static_cast<int>(index / cols);
+    const int col = static_cast<int>(index - static_cast<std::int64_t>(row) * cols);
+    const int axis = dominantAxis(geometry.detectorPoint_ijk(col, row) - source_ijk);
+    RayPacket* open = packets.empty() ? nullptr : &packets.back();
+    if (open && index == previous + 1 && col > 0 && open->axis == axis && open->count < SiddonPacketKernel::kLanes) {
+      ++open->count;
+    } else {
+      packets.push_back({n, 1, axis});
+    }
+    alongI = alongI || axis == 0;
+    previous = index;
+  }
+  // The kernel needs a window's worth of voxels along the contiguous axis (i, or j for rays along i).
+  const Eigen::Vector3i& n = vol.dims();
+  const bool usable[3] = {n.y() >= SiddonPacketKernel::kWindow, n.x() >= SiddonPacketKernel::kWindow,
+                          n.x() >= SiddonPacketKernel::kWindow};
+  SiddonPacketLayout layouts[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    if (usable[axis] && (axis != 0 || alongI)) layouts[axis] = packetLayout(axis);  // before the threads start
+  }
+  const Eigen::Vector3d grid0 = source_ijk.array() + 0.5;  // grid coordinates: voxel m covers [m, m+1)
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets.size(), 8), [&](const tbb::blocked_range<std::size_t>& range) {
+    SiddonPacketRay rays[SiddonPacketKernel::kLanes];
+    for (std::size_t p = range.begin(); p != range.end(); ++p) {
+      const RayPacket& packet = packets[p];
+      const int d = packet.axis, h = d == 0 ? 1 : 0, v = d == 2 ? 1 : 2;
+      for (int r = 0; r < packet.count; ++r) {
+        const std::int64_t index = pixelAt(packet.first + static_cast<std::size_t>(r));
+        const int row = static_cast<int>(index / cols);
+        const int col = static_cast<int>(index - static_cast<std::int64_t>(row) * cols);
+        const Eigen::Vector3d pixel_ijk = geometry.detectorPoint_ijk(col, row);
+        if (!usable[d]) {
+          values[packet.first + static_cast<std::size_t>(r)] =
+              static_cast<float>(integrateIjk(source_ijk, pixel_ijk, geometry.rayLength_mm(col, row)));
+          continue;
+        }
+        const Eigen::Vector3d dir = pixel_ijk - source_ijk;
+        SiddonPacketRay& ray = rays[r];
+        ray = SiddonPacketRay{};
+        double t0 = 0.0, t1 = 1.0;
+        if (vol.hasContent() &&
+            DrrRayGeometry::clipToBox(source_ijk, dir, vol.contentBoxMin_ijk(), vol.contentBoxMax_ijk(), t0, t1)) {
+          const double u0 = grid0[d] + t0 * dir[d], u1 = grid0[d] + t1 * dir[d];
+          ray.uBegin = std::min(u0, u1);
+          ray.uEnd = std::max(u0, u1);
+          ray.hPerU = dir[h] / dir[d];
+          ray.h0 = grid0[h] - ray.hPerU * grid0[d];
+          ray.vPerU = dir[v] / dir[d];
+          ray.v0 = grid0[v] - ray.vPerU * grid0[d];
+          ray.mmPerU = geometry.rayLength_mm(col, row) / std::abs(dir[d]);
+        }
+      }
+      if (usable[d]) SiddonPacketKernel::integrate(layouts[d], rays, packet.count, values + packet.first);
+    }
+  });
+  return {};
+}
 
 double SiddonRayCaster::integrateIjk(const Eigen::Vector3d& a_ijk, const Eigen::Vector3d& b_ijk,
                                             double length_mm) const {

@@ -7,6 +7,8 @@
 #include <limits>
 #include <numbers>
 
+#include "Base/LargePages.h"
+
 namespace fct {
 
 namespace {
@@ -71,7 +73,7 @@ Result<SliceStack> SliceStack::create(const Eigen::Vector2i& size_px, const Eige
     }
   }
   stack.m_origins_lps_mm = std::move(sliceOrigins_lps_mm);
-  stack.m_pixels.assign(stack.sliceOffset(stack.sliceCount()), 0.0f);
+  assignWithLargePages(stack.m_pixels, stack.sliceOffset(stack.sliceCount()), 0.0f);
   return stack;
 }
 
@@ -113,11 +115,10 @@ Result<Volume> SliceStack::toVolume() && {
   }
   Eigen::Matrix3d direction;
   direction << m_rowCosine_lps, m_columnCosine_lps, normal_lps();
-  auto volume = Volume::create({m_size_px.x(), m_size_px.y(), sliceCount()},
-                               {m_pixelSpacing_mm.x(), m_pixelSpacing_mm.y(), layout.meanGap_mm},
-                               m_origins_lps_mm.front(), direction);
-  if (!volume) return volume;
-  volume.value().voxels() = std::move(m_pixels);
+  auto volume = Volume::fromVoxels({m_size_px.x(), m_size_px.y(), sliceCount()},
+                                   {m_pixelSpacing_mm.x(), m_pixelSpacing_mm.y(), layout.meanGap_mm},
+                                   m_origins_lps_mm.front(), direction, std::move(m_pixels));
+  m_pixels.clear();
   m_origins_lps_mm.clear();
   return volume;
 }

@@ -120,3 +120,32 @@ TEST(DrrVolume, ParsesValueKindNames) {
   }
   EXPECT_FALSE(fct::DrrVolume::parseValueKind("hu").ok());
 }
+
+TEST(DrrVolume, JFastestCopyHoldsEveryValueAndIsSharedByCopies) {
+  fct::Volume ct = fct::Volume::create({5, 4, 3}, {1, 1, 1}).value();
+  for (std::size_t n = 0; n < ct.voxels().size(); ++n) ct.voxels()[n] = static_cast<float>(n);
+  fct::DrrValueOptions options;
+  options.kind = fct::DrrValueKind::Raw;
+  const fct::DrrVolume volume = fct::DrrVolume::create(ct, options).value();
+  const fct::DrrVolume copy = volume;
+  const std::vector<float>& jFastest = copy.valuesJFastest();
+  ASSERT_EQ(jFastest.size(), ct.voxels().size());
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 5; ++i) EXPECT_EQ(jFastest[static_cast<std::size_t>(j + 4 * (i + 5 * k))], ct.at(i, j, k));
+  EXPECT_EQ(volume.valuesJFastest().data(), jFastest.data());  // made once, shared
+}
+
+TEST(DrrVolume, ConvertingInPlaceGivesTheSameValuesAsACopy) {
+  fct::Volume ct = fct::Volume::create({6, 5, 4}, {0.5, 0.7, 2.0}, {10, 20, 30}).value();
+  for (std::size_t n = 0; n < ct.voxels().size(); ++n) ct.voxels()[n] = -1100.0f + 37.0f * static_cast<float>(n);
+  const fct::DrrVolume copied = fct::DrrVolume::create(ct).value();
+  fct::Volume consumed = ct;
+  const fct::DrrVolume inPlace = fct::DrrVolume::create(std::move(consumed)).value();
+  EXPECT_EQ(inPlace.values().voxels(), copied.values().voxels());
+  EXPECT_EQ(inPlace.contentBoxMin_ijk(), copied.contentBoxMin_ijk());
+  EXPECT_EQ(inPlace.values().origin_lps_mm(), ct.origin_lps_mm());
+  fct::Volume broken = ct;
+  broken.voxels()[7] = NAN;
+  EXPECT_NE(fct::DrrVolume::create(std::move(broken)).error().find("NaN"), std::string::npos);
+}

@@ -1,0 +1,23 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "Base/LargePages.h"
+
+TEST(LargePages, AssignGivesCountCopiesOfTheFillWhateverTheSize) {
+  for (const std::size_t count : {std::size_t{0}, std::size_t{3}, std::size_t{40'000'000}}) {
+    std::vector<float> values(17, -1.0f);
+    fct::assignWithLargePages(values, count, 2.5f);
+    ASSERT_EQ(values.size(), count);
+    EXPECT_TRUE(std::all_of(values.begin(), values.end(), [](float v) { return v == 2.5f; }));
+  }
+}
+
+TEST(LargePages, AdviceOnRangesSmallerThanAPageOrUnalignedChangesNothing) {
+  std::vector<float> values(1000, 1.0f);
+  fct::adviseLargePages(values.data() + 1, 10);
+  fct::adviseLargePages(values.data(), values.size() * sizeof(float));
+  fct::adviseLargePages(nullptr, 0);
+  EXPECT_TRUE(std::all_of(values.begin(), values.end(), [](float v) { return v == 1.0f; }));
+}
