@@ -25,6 +25,7 @@
 
 #include "Drr/DrrRendererFactory.h"
 #include "Drr/DrrVolume.h"
+#include "Drr/SiddonRayCaster.h"
 #include "Drr/TransgraphRenderer.h"
 #include "Geometry/Camera.h"
 #include "Geometry/RigidPose.h"
@@ -307,6 +308,12 @@ void benchmarkCt(const std::string& name, const fct::Volume& ctIn, const Options
   fct::FloatImage raycastImage;
   (void)raycast->render(view, pose, 0, raycastImage);
   const Timed siddonTime = timeRenderer(*siddon, "siddon", NAN, "");
+  // The one-ray-at-a-time walk, against which the AVX-512 packets of the default are measured.
+  const fct::SiddonRayCaster siddonScalar(volume, fct::SiddonTraversal::Scalar);
+  fct::FloatImage scalarImage;
+  (void)siddonScalar.render(view, pose, 0, scalarImage);
+  const Timed scalarTime = timeRenderer(siddonScalar, "siddon_scalar", ncc(scalarImage.pixels, siddonImage.pixels),
+                                        "NCC vs siddon");
   const Timed raycastTime =
       timeRenderer(*raycast, "raycast", ncc(raycastImage.pixels, siddonImage.pixels), "NCC vs siddon");
 
@@ -363,6 +370,8 @@ void benchmarkCt(const std::string& name, const fct::Volume& ctIn, const Options
     if (std::isfinite(a) && std::isfinite(b) && b > 0) ratios.push_back(fmt::format("ratio {} {}: {:.3f}", what, name, a / b));
   };
   ratio("siddon/plastimatch_exact", siddonTime.fullN, plastimatch_s);
+  ratio("siddon/siddon_scalar", siddonTime.fullN, scalarTime.fullN);
+  ratio("roi_siddon/roi_siddon_scalar", siddonTime.roiN, scalarTime.roiN);
   ratio("raycast/plastimatch_exact", raycastTime.fullN, plastimatch_s);
   ratio("transgraph/raycast", transgraphTime.fullN, raycastTime.fullN);
   ratio("transgraph/siddon", transgraphTime.fullN, siddonTime.fullN);

@@ -9,6 +9,8 @@
 #include "Drr/SiddonPacketKernel.h"
 #include "Drr/SiddonRayCaster.h"
 #include "DrrTestPhantoms.h"
+#include "Simulation/PhantomBuilder.h"
+#include "Simulation/StandardViews.h"
 
 namespace {
 
@@ -111,4 +113,36 @@ TEST(SiddonPacketKernel, NarrowVolumesAndMissingRaysUseTheScalarResult) {
   away.translation() = Eigen::Vector3d(0.0, 0.0, 5000.0);
   const fct::FloatImage empty = renderer.render(fct::test::phantomCamera(Eigen::Matrix3d::Identity()), away).value();
   EXPECT_EQ(*std::max_element(empty.pixels.begin(), empty.pixels.end()), 0.0f);
+}
+
+TEST(SiddonPacketKernel, MatchesTheScalarTraversalOnThePhantomAndItsCoarseLevels) {
+  if (!fct::SiddonPacketKernel::available()) GTEST_SKIP() << "this processor has no AVX-512F; renders use the scalar traversal";
+  fct::PhantomOptions phantom;
+  phantom.dims = Eigen::Vector3i(80, 80, 60);
+  phantom.spacing_mm = 2.0;
+  const auto full = std::make_shared<const fct::DrrVolume>(
+      fct::DrrVolume::create(fct::PhantomBuilder::build(phantom).value()).value());
+  fct::StandardViewOptions viewOptions;
+  viewOptions.count = 5;
+  viewOptions.cols = 192;
+  viewOptions.rows = 160;
+  viewOptions.pixelSpacing_mm = 1.6;
+  viewOptions.sourceToIsocentre_mm = 700.0;
+  viewOptions.sourceToDetector_mm = 1000.0;
+  const auto views = fct::StandardViews::build(Eigen::Vector3d::Zero(), viewOptions).value();
+  Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();
+  T_world_from_ct.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d(1, -2, 3).normalized()).toRotationMatrix();
+  T_world_from_ct.translation() = -full->values().centre_lps_mm() + Eigen::Vector3d(2.0, -3.0, 1.5);
+  for (const int block : {1, 2}) {
+    const auto volume = block == 1 ? full : std::make_shared<const fct::DrrVolume>(full->coarsened(Eigen::Vector3i::Constant(block)).value());
+    const fct::SiddonRayCaster packets(volume, fct::SiddonTraversal::Fastest);
+    const fct::SiddonRayCaster scalar(volume, fct::SiddonTraversal::Scalar);
+    for (const fct::ViewSpec& view : views) {
+      for (const int level : {0, 1, 2}) {
+        const fct::FloatImage fast = packets.render(view.camera, T_world_from_ct, level).value();
+        const fct::FloatImage reference = scalar.render(view.camera, T_world_from_ct, level).value();
+        EXPECT_LT(maxRelativeDifference(fast, reference), 5e-6) << view.name << " level " << level << " block " << block;
+      }
+    }
+  }
 }
