@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "CliSupport.h"
@@ -139,11 +140,19 @@ int runDrr(const DrrCommandOptions& options) {
     if (!rendered.ok()) return reportError(fmt::format("view '{}': {}", selected[n].name, rendered.error()));
     seconds[n] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+  // The files are written side by side (each durably, so their flushes to disk overlap); errors in view order.
+  std::vector<Status> written(selected.size(), Ok{});
+  std::vector<std::thread> writers;
   for (std::size_t n = 0; n < selected.size(); ++n) {
+    writers.emplace_back([&, n] {
+      const Eigen::Vector2d spacing_mm = selected[n].camera.downsampled(options.level).intrinsics().pixelSpacing_mm;
+      written[n] = writeDrr(images[n], outputPath(options, selected[n].name), extension, spacing_mm);
+    });
+  }
+  for (std::thread& writer : writers) writer.join();
+  for (std::size_t n = 0; n < selected.size(); ++n) {
+    if (!written[n].ok()) return reportError(written[n].error());
     const fs::path path = outputPath(options, selected[n].name);
-    const Eigen::Vector2d spacing_mm = selected[n].camera.downsampled(options.level).intrinsics().pixelSpacing_mm;
-    const Status written = writeDrr(images[n], path, extension, spacing_mm);
-    if (!written.ok()) return reportError(written.error());
     const auto [lo, hi] = std::minmax_element(images[n].pixels.begin(), images[n].pixels.end());
     fmt::print("wrote {}: {} x {} px, {} {} DRR, level {}, values {:.4g}..{:.4g}, {:.3f} s\n", path.string(),
                images[n].cols, images[n].rows, options.method, options.values, options.level, *lo, *hi, seconds[n]);

@@ -5,6 +5,7 @@
 // page faults to a few milliseconds (docs/performance.md).
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace fct {
@@ -17,5 +18,9 @@ void adviseLargePages(void* data, std::size_t bytes);
 /// Replaces `values` by `count` copies of `fill` in a fresh allocation advised for large pages before it is first
 /// touched. Throws std::bad_alloc like std::vector::assign when the memory is not available.
 void assignWithLargePages(std::vector<float>& values, std::size_t count, float fill);
+
+/// `count` floats of fresh, uninitialized memory advised for large pages and already mapped (for a buffer that is
+/// about to be overwritten whole, which saves the fill). Throws std::bad_alloc when the memory is not available.
+std::unique_ptr<float[]> allocateWithLargePages(std::size_t count);
 
 }  // namespace fct

@@ -110,12 +110,12 @@ Result<DrrVolume> DrrVolume::coarsened(const Eigen::Vector3i& blockSize_ijk) con
   return volume;
 }
 
-const std::vector<float>& DrrVolume::valuesJFastest() const {
+const float* DrrVolume::valuesJFastest() const {
   std::call_once(m_jFastest->made, [this] {
     const Eigen::Vector3i& n = dims();
-    assignWithLargePages(m_jFastest->values, m_values.voxelCount(), 0.0f);
+    m_jFastest->values = allocateWithLargePages(m_values.voxelCount());  // every value is written below
     const float* source = data();
-    float* target = m_jFastest->values.data();
+    float* target = m_jFastest->values.get();
     constexpr int kBlock = 16;  // i values per task: one cache line of each source row
     const int blocks = (n.x() + kBlock - 1) / kBlock;
     tbb::parallel_for(tbb::blocked_range<int>(0, n.z() * blocks), [&](const tbb::blocked_range<int>& tasks) {
@@ -129,7 +129,7 @@ const std::vector<float>& DrrVolume::valuesJFastest() const {
       }
     });
   });
-  return m_jFastest->values;
+  return m_jFastest->values.get();
 }
 
 void DrrVolume::findContentBox() {

@@ -67,7 +67,7 @@ class DrrVolume {
   /// The same values with j fastest, then i, then k (value (i,j,k) at j + nj·(i + ni·k)): the layout in which rays
   /// running along i read neighbouring j contiguously (SiddonRayCaster's packets). Made on the first call (one more
   /// copy of the values in memory), then shared by every renderer and copy of this volume; thread-safe.
-  const std::vector<float>& valuesJFastest() const;
+  const float* valuesJFastest() const;
   /// Map from CT physical mm (LPS) to continuous voxel index.
   const Eigen::Affine3d& T_ijk_from_ct() const { return m_T_ijk_from_ct; }
   /// Map from continuous voxel index to CT physical mm (LPS).
@@ -96,7 +96,7 @@ class DrrVolume {
   /// The j-fastest copy, made once on demand.
   struct JFastestCopy {
     std::once_flag made;
-    std::vector<float> values;
+    std::unique_ptr<float[]> values;
   };
 
   Volume m_values;

@@ -36,6 +36,9 @@ namespace {
 /// packet's first column), so that a lane's result does not depend on the packet it is in.
 constexpr int kFlushColumns = 64;
 
+/// How many columns ahead the walk prefetches its rows.
+constexpr int kPrefetchColumns = 8;
+
 /// 1 / slope, or 0 for a slope so small that the ray cannot cross a boundary of that axis within a column.
 float inverseSlope(double perU) { return std::abs(perU) > 1e-30 ? static_cast<float>(1.0 / perU) : 0.0f; }
 
@@ -126,10 +129,9 @@ FCT_AVX512 void integratePacket(const SiddonPacketLayout& layout, const SiddonPa
     const __m512i hB = cellAt(ce, hSlope, hStart, hLast), vB = cellAt(ce, vSlope, vStart, vLast);
     const __mmask16 inColumn = _mm512_cmp_ps_mask(len, zero, _CMP_GT_OQ);
     if (inColumn) {
-      const __m512 uH = _mm512_mul_ps(_mm512_sub_ps(_mm512_cvtepi32_ps(_mm512_max_epi32(hA, hB)), hStart), hInverse);
-      const __m512 uV = _mm512_mul_ps(_mm512_sub_ps(_mm512_cvtepi32_ps(_mm512_max_epi32(vA, vB)), vStart), vInverse);
-      const __m512 afterH = _mm512_min_ps(_mm512_max_ps(_mm512_sub_ps(ce, uH), zero), len);
-      const __m512 afterV = _mm512_min_ps(_mm512_max_ps(_mm512_sub_ps(ce, uV), zero), len);
+      // Lanes that cross a boundary of H or V in this column (most columns have no crossing of V, many none of H;
+      // where no lane crosses, the terms of that crossing are exactly zero and are skipped).
+      const __mmask16 crossH = _mm512_cmpneq_epi32_mask(hA, hB), crossV = _mm512_cmpneq_epi32_mask(vA, vB);
       const float* slab = layout.data + static_cast<std::ptrdiff_t>(m) * layout.strideD;
       // The window: the rays of a packet fan out monotonically along H, so the packet's first and last rays bound
       // the others; checked over the lanes in this column, and found by full reductions where the guess fails.
@@ -147,6 +149,14 @@ FCT_AVX512 void integratePacket(const SiddonPacketLayout& layout, const SiddonPa
         const float* row1 = vMin + 1 < layout.countV ? row0 + layout.strideV : row0;
         const __m512 low0 = _mm512_loadu_ps(row0), high0 = _mm512_loadu_ps(row0 + 16);
         const __m512 low1 = _mm512_loadu_ps(row1), high1 = _mm512_loadu_ps(row1 + 16);
+        // The rows of a few columns ahead (about where the packet will be): hides the cache misses of the walk.
+        // Addresses as integers: near the volume's end they may lie past it, where a prefetch is harmless.
+        const std::uintptr_t ahead = static_cast<std::uintptr_t>(kPrefetchColumns * layout.strideD) * sizeof(float);
+        for (const float* row : {row0, row1}) {
+          const std::uintptr_t address = reinterpret_cast<std::uintptr_t>(row) + ahead;
+          _mm_prefetch(reinterpret_cast<const char*>(address), _MM_HINT_T0);
+          _mm_prefetch(reinterpret_cast<const char*>(address + (W - 1) * sizeof(float)), _MM_HINT_T0);
+        }
         const __m512i offset = _mm512_set1_epi32(start);
         // Lanes outside this column may lie outside the window: clamp their (unused) positions into it.
         const __m512i iA = _mm512_min_epu32(_mm512_sub_epi32(hA, offset), windowLast);
@@ -154,9 +164,9 @@ FCT_AVX512 void integratePacket(const SiddonPacketLayout& layout, const SiddonPa
         const __m512i rowMin = _mm512_set1_epi32(vMin);
         const __mmask16 upperA = _mm512_cmpgt_epi32_mask(vA, rowMin), upperB = _mm512_cmpgt_epi32_mask(vB, rowMin);
         v00 = pick(low0, high0, low1, high1, iA, upperA);
-        v10 = pick(low0, high0, low1, high1, iB, upperA);
-        v01 = pick(low0, high0, low1, high1, iA, upperB);
-        v11 = pick(low0, high0, low1, high1, iB, upperB);
+        v10 = crossH ? pick(low0, high0, low1, high1, iB, upperA) : v00;
+        v01 = crossV ? pick(low0, high0, low1, high1, iA, upperB) : v00;
+        v11 = !crossV ? v10 : crossH ? pick(low0, high0, low1, high1, iB, upperB) : v01;
       } else {
         // The lanes spread over more than the window (rare): load each lane's voxels one by one.
         alignas(64) std::int32_t ha[L], hb[L], va[L], vb[L];
@@ -179,13 +189,24 @@ FCT_AVX512 void integratePacket(const SiddonPacketLayout& layout, const SiddonPa
         v11 = _mm512_load_ps(f11);
       }
       // The column's integral: len·v00, plus the part after the H crossing at v10 - v00, after the V crossing at
-      // v01 - v00, and after both at the corner term (exact for either crossing order).
-      const __m512 dH = _mm512_sub_ps(v10, v00), dV = _mm512_sub_ps(v01, v00);
-      const __m512 dHV = _mm512_sub_ps(_mm512_sub_ps(v11, v10), dV);
+      // v01 - v00, and after both at the corner term (exact for either crossing order). A skipped term would have
+      // added an exact zero, so a lane's sum does not depend on whether other lanes cross.
       acc0 = _mm512_fmadd_ps(len, v00, acc0);
-      acc1 = _mm512_fmadd_ps(afterH, dH, acc1);
-      acc0 = _mm512_fmadd_ps(afterV, dV, acc0);
-      acc1 = _mm512_fmadd_ps(_mm512_min_ps(afterH, afterV), dHV, acc1);
+      __m512 afterH = zero;
+      if (crossH) {
+        const __m512 uH = _mm512_mul_ps(_mm512_sub_ps(_mm512_cvtepi32_ps(_mm512_max_epi32(hA, hB)), hStart), hInverse);
+        afterH = _mm512_min_ps(_mm512_max_ps(_mm512_sub_ps(ce, uH), zero), len);
+        acc1 = _mm512_fmadd_ps(afterH, _mm512_sub_ps(v10, v00), acc1);
+      }
+      if (crossV) {
+        const __m512 uV = _mm512_mul_ps(_mm512_sub_ps(_mm512_cvtepi32_ps(_mm512_max_epi32(vA, vB)), vStart), vInverse);
+        const __m512 afterV = _mm512_min_ps(_mm512_max_ps(_mm512_sub_ps(ce, uV), zero), len);
+        const __m512 dV = _mm512_sub_ps(v01, v00);
+        acc0 = _mm512_fmadd_ps(afterV, dV, acc0);
+        if (crossH) {
+          acc1 = _mm512_fmadd_ps(_mm512_min_ps(afterH, afterV), _mm512_sub_ps(_mm512_sub_ps(v11, v10), dV), acc1);
+        }
+      }
     }
     if ((m + 1) % kFlushColumns == 0 || m == mLast) {
       const __m512 block = _mm512_add_ps(acc0, acc1);

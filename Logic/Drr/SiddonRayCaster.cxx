@@ -43,7 +43,7 @@ SiddonPacketLayout SiddonRayCaster::packetLayout(int axis) const {
   const std::ptrdiff_t slice = static_cast<std::ptrdiff_t>(n.x()) * n.y();
   if (axis == 1) return {vol.data(), n.y(), n.x(), n.z(), n.x(), slice};
   if (axis == 2) return {vol.data(), n.z(), n.x(), n.y(), slice, n.x()};
-  return {vol.valuesJFastest().data(), n.x(), n.y(), n.z(), n.y(), slice};
+  return {vol.valuesJFastest(), n.x(), n.y(), n.z(), n.y(), slice};
 }
 
 DrrRenderStats SiddonRayCaster::integratePixels(const Camera& levelCamera, const Eigen::Isometry3d& T_world_from_ct,

@@ -454,6 +454,12 @@ void wholeProcess(const fs::path& dicomFolder, const Options& options, std::vect
     return v[v.size() / 2];
   };
   const double ours_s = median(oursTimes), theirs_s = median(theirsTimes);
+  const auto list = [](const std::vector<double>& v) {
+    std::string text;
+    for (const double s : v) text += fmt::format("{}{:.3f}", text.empty() ? "" : " ", s);
+    return text;
+  };
+  fmt::print("   runs, alternating: fluoroct drr {} s; plastimatch {} s\n", list(oursTimes), list(theirsTimes));
   double nccMin = 1.0;
   for (int k = 0; k < n; ++k) {
     auto a = readPfm(options.workDir / fmt::format("ours_{}.pfm", views[static_cast<std::size_t>(k)].name), kCols, kRows);
