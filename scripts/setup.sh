@@ -10,7 +10,7 @@ FCT_BUILD="${FCT_BUILD_DIR:-$FCT_ROOT/build}"
 
 FCT_PACKAGES=(
   cmake ninja-build ccache g++ pkg-config
-  qt6-base-dev libqt6opengl6-dev libxkbcommon-dev libgl-dev libvtk9-dev libeigen3-dev libopencv-dev libdcmtk-dev
+  qt6-base-dev libqt6opengl6-dev libxkbcommon-dev libgl-dev libvtk9-dev libeigen3-dev libopencv-dev libpng-dev libtiff-dev libdcmtk-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev libfmt-dev libtbb-dev libcli11-dev zlib1g-dev libopenigtlink-dev
   libxml2-dev libnlopt-dev
   xvfb xauth plastimatch parallel dicom3tools

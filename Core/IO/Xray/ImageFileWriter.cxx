@@ -1,6 +1,8 @@
 #include "IO/Xray/ImageFileWriter.h"
 
 #include "Base/AtomicFile.h"
+#include "IO/Xray/PngCodec.h"
+#include "IO/Xray/TiffCodec.h"
 
 #include <fmt/core.h>
 
@@ -10,9 +12,6 @@
 #include <cstdint>
 #include <string>
 #include <vector>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 namespace fct {
 
@@ -39,21 +38,10 @@ std::string rawBytes(const std::string& header, const FloatImage& image, bool bo
   return bytes;
 }
 
-/// Encodes `mat` in the format of `path`'s extension in memory, then writes it with AtomicFile.
-Status encodeAndWrite(const std::filesystem::path& path, const cv::Mat& mat) {
-  std::vector<unsigned char> encoded;
-  try {
-    if (!cv::imencode(path.extension().string(), mat, encoded)) {
-      return fail(fmt::format("cannot write '{}': OpenCV's encoder refused the image", path.string()));
-    }
-  } catch (const cv::Exception& e) {
-    return fail(fmt::format("cannot write '{}': {}", path.string(), e.what()));
-  }
-  return AtomicFile::write(path, {AtomicFile::bytesOf(encoded.data(), encoded.size())});
-}
-
-cv::Mat wrap(const FloatImage& image) {
-  return cv::Mat(image.rows, image.cols, CV_32F, const_cast<float*>(image.pixels.data()));  // read-only use
+/// Writes encoded bytes (or the encoder's error, naming `path`) with AtomicFile.
+Status writeEncoded(const std::filesystem::path& path, const Result<std::string>& encoded) {
+  if (!encoded) return fail(fmt::format("cannot write '{}': {}", path.string(), encoded.error()));
+  return AtomicFile::write(path, {encoded.value()});
 }
 
 }  // namespace
@@ -69,7 +57,7 @@ Status ImageFileWriter::writePfm(const FloatImage& image, const std::filesystem:
 
 Status ImageFileWriter::writeTiff(const FloatImage& image, const std::filesystem::path& path) {
   if (Status ok = checkImage(image, path); !ok) return ok;
-  return encodeAndWrite(path, wrap(image));
+  return writeEncoded(path, TiffCodec::encodeFloat32(image.pixels.data(), image.cols, image.rows));
 }
 
 Status ImageFileWriter::writePng16(const FloatImage& image, const std::filesystem::path& path, float windowMin,
@@ -79,17 +67,13 @@ Status ImageFileWriter::writePng16(const FloatImage& image, const std::filesyste
     return fail(fmt::format("cannot write '{}': window {} .. {} must be finite with min < max", path.string(), windowMin,
                             windowMax));
   }
-  cv::Mat png(image.rows, image.cols, CV_16U);
+  std::vector<std::uint16_t> grey(image.pixels.size());
   const double scale = 65535.0 / (static_cast<double>(windowMax) - windowMin);
-  for (int r = 0; r < image.rows; ++r) {
-    auto* out = png.ptr<std::uint16_t>(r);
-    for (int c = 0; c < image.cols; ++c) {
-      const float v = image.at(c, r);
-      const double mapped = std::isnan(v) ? 0.0 : std::clamp((v - windowMin) * scale, 0.0, 65535.0);
-      out[c] = static_cast<std::uint16_t>(std::lround(mapped));
-    }
-  }
-  return encodeAndWrite(path, png);
+  std::transform(image.pixels.begin(), image.pixels.end(), grey.begin(), [&](float v) {
+    const double mapped = std::isnan(v) ? 0.0 : std::clamp((v - windowMin) * scale, 0.0, 65535.0);
+    return static_cast<std::uint16_t>(std::lround(mapped));
+  });
+  return writeEncoded(path, PngCodec::encodeGrey16(grey.data(), image.cols, image.rows));
 }
 
 Status ImageFileWriter::writePngRgb(const RgbImage& image, const std::filesystem::path& path) {
@@ -97,10 +81,7 @@ Status ImageFileWriter::writePngRgb(const RgbImage& image, const std::filesystem
     return fail(fmt::format("cannot write '{}': colour image is empty or inconsistent ({} x {} with {} bytes)",
                             path.filename().string(), image.cols, image.rows, image.pixels.size()));
   }
-  cv::Mat bgr;
-  cv::cvtColor(cv::Mat(image.rows, image.cols, CV_8UC3, const_cast<std::uint8_t*>(image.pixels.data())), bgr,
-               cv::COLOR_RGB2BGR);
-  return encodeAndWrite(path, bgr);
+  return writeEncoded(path, PngCodec::encodeRgb8(image.pixels.data(), image.cols, image.rows));
 }
 
 Status ImageFileWriter::writeNrrd2d(const FloatImage& image, const std::filesystem::path& path,

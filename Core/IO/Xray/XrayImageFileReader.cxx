@@ -2,23 +2,22 @@
 
 #include <fmt/core.h>
 
+#include "IO/Xray/PngCodec.h"
+#include "IO/Xray/TiffCodec.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <optional>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 namespace fct {
 
 namespace {
 
 /// True when the file starts with the signature of its format (PNG: 89 'PNG' 0D 0A 1A 0A; TIFF: "II*\0", "MM\0*", or
-/// BigTIFF "II+\0", "MM\0+"). OpenCV picks its decoder from the content, not the name: without this check a file
-/// named .png holding, say, DICOM bytes reaches a decoder (GDCM) that aborts the program on damaged input.
+/// BigTIFF "II+\0", "MM\0+"), so that a file under the wrong name gets an error that says so.
 bool hasSignature(std::ifstream& file, const std::string& modality) {
   char head[8] = {};
   file.read(head, sizeof head);
@@ -32,7 +31,7 @@ bool hasSignature(std::ifstream& file, const std::string& modality) {
 }
 
 /// The largest image FluoroCT decodes: more than any X-ray detector (a 43 cm flat panel at 0.1 mm is 4300 pixels a
-/// side). OpenCV allocates the whole image its header declares before it decodes a byte, so a damaged header would
+/// side). A decoder allocates the whole image its header declares before it decodes a byte, so a damaged header would
 /// otherwise ask for gigabytes.
 constexpr std::uint64_t kMaxImageSide = 16384;
 constexpr std::uint64_t kMaxImagePixels = std::uint64_t{1} << 25;  // 33.5 million: 5792 x 5792
@@ -61,7 +60,7 @@ std::optional<DeclaredSize> pngDeclaredSize(std::ifstream& file) {
 }
 
 /// The ImageWidth (256) and ImageLength (257) of a TIFF's first directory, classic or BigTIFF; nullopt when the
-/// directory cannot be read or lacks either tag (OpenCV then reports the file itself).
+/// directory cannot be read or lacks either tag (libtiff then reports the file itself).
 std::optional<DeclaredSize> tiffDeclaredSize(std::ifstream& file) {
   const auto order = readUnsigned(file, 0, 2, false);
   if (!order) return std::nullopt;
@@ -89,11 +88,34 @@ std::optional<DeclaredSize> tiffDeclaredSize(std::ifstream& file) {
   return DeclaredSize{*cols, *rows};
 }
 
-/// True when every pixel has equal B, G and R values (a grey image stored as colour).
-bool channelsEqual(const cv::Mat& bgr) {
-  std::vector<cv::Mat> planes;
-  cv::split(bgr, planes);
-  return cv::countNonZero(planes[0] != planes[1]) == 0 && cv::countNonZero(planes[1] != planes[2]) == 0;
+/// The grey image of a decoded raster: channel 0 of grey (+ alpha) and of RGB(A) whose channels agree everywhere,
+/// otherwise luma 0.299 R + 0.587 G + 0.114 B (rounded to the nearest integer for integer samples). Says in
+/// `warnings` what it dropped or converted.
+std::vector<float> greyOf(const DecodedRaster& raster, const std::string& name, std::vector<std::string>& warnings) {
+  const auto pixels = static_cast<std::size_t>(raster.cols) * raster.rows;
+  const auto step = static_cast<std::size_t>(raster.channels);
+  const float* in = raster.samples.data();
+  if (raster.channels == 2 || raster.channels == 4) warnings.push_back(fmt::format("'{}': alpha channel ignored", name));
+  bool sameChannels = raster.channels < 3;
+  if (!sameChannels) {
+    sameChannels = true;
+    for (std::size_t n = 0; n < pixels && sameChannels; ++n) {
+      sameChannels = in[n * step] == in[n * step + 1] && in[n * step + 1] == in[n * step + 2];
+    }
+  }
+  std::vector<float> grey(pixels);
+  if (sameChannels) {
+    for (std::size_t n = 0; n < pixels; ++n) grey[n] = in[n * step];
+    return grey;
+  }
+  const bool integer = raster.sampleType != RasterSampleType::Float32;
+  for (std::size_t n = 0; n < pixels; ++n) {
+    const double luma = 0.299 * in[n * step] + 0.587 * in[n * step + 1] + 0.114 * in[n * step + 2];
+    grey[n] = static_cast<float>(integer ? std::round(luma) : luma);
+  }
+  warnings.push_back(
+      fmt::format("'{}' is a colour image; converted to grey (luma 0.299 R + 0.587 G + 0.114 B)", name));
+  return grey;
 }
 
 }  // namespace
@@ -126,57 +148,38 @@ Result<XrayImage> XrayImageFileReader::read(const std::filesystem::path& path) {
                             "a side and {} pixels in all (a damaged file, or not an X-ray image?)",
                             path.filename().string(), size->cols, size->rows, kMaxImageSide, kMaxImagePixels));
   }
-  std::vector<std::string> warnings;
-  cv::Mat grey;
-  try {
-    cv::Mat loaded = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-    if (loaded.empty()) {
-      return fail(fmt::format("cannot decode '{}' as {}; the file may be truncated or not an image",
-                              path.filename().string(), modality));
-    }
-    if (loaded.channels() == 1) {
-      grey = loaded;
-    } else if (loaded.channels() == 3 || loaded.channels() == 4) {
-      cv::Mat bgr;
-      if (loaded.channels() == 4) {
-        cv::cvtColor(loaded, bgr, cv::COLOR_BGRA2BGR);
-        warnings.push_back(fmt::format("'{}': alpha channel ignored", path.filename().string()));
-      } else {
-        bgr = loaded;
-      }
-      if (channelsEqual(bgr)) {
-        cv::extractChannel(bgr, grey, 0);
-      } else {
-        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-        warnings.push_back(fmt::format("'{}' is a colour image; converted to grey (luma 0.299 R + 0.587 G + 0.114 B)",
-                                       path.filename().string()));
-      }
-    } else {
-      return fail(fmt::format("'{}' has {} channels; expected a grey-scale or RGB image", path.filename().string(),
-                              loaded.channels()));
-    }
-  } catch (const cv::Exception& e) {
-    return fail(fmt::format("cannot read '{}': {}", path.filename().string(), e.what()));
+  header.clear();
+  header.seekg(0, std::ios::end);
+  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(header.tellg(), 0)), '\0');
+  header.seekg(0);
+  if (!header.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) {
+    return fail(fmt::format("cannot read '{}': the file could not be read to its end", path.string()));
   }
+  const std::string name = path.filename().string();
+  auto raster = modality == "PNG" ? PngCodec::decode(bytes, kMaxImageSide)
+                                  : TiffCodec::decode(bytes, kMaxImagePixels * 4 * sizeof(float));
+  if (!raster) {
+    const bool unsupported = raster.error().find("unsupported pixel type") != std::string::npos;
+    return fail(unsupported ? fmt::format("'{}' has an {}", name, raster.error())
+                            : fmt::format("cannot decode '{}' as {} ({}); the file may be truncated or damaged", name,
+                                          modality, raster.error()));
+  }
+  const DecodedRaster& decoded = raster.value();
+  if (static_cast<std::uint64_t>(decoded.cols) * decoded.rows > kMaxImagePixels) {
+    return fail(fmt::format("'{}' holds an image of {} x {} pixels; FluoroCT reads X-ray images of at most {} pixels",
+                            name, decoded.cols, decoded.rows, kMaxImagePixels));
+  }
+  std::vector<std::string> warnings;
+  for (const std::string& note : decoded.notes) warnings.push_back(fmt::format("'{}': {}", name, note));
 
   XrayImage image;
-  switch (grey.depth()) {
-    case CV_8U: image.bitsStored = 8; break;
-    case CV_16U: image.bitsStored = 16; break;
-    case CV_32F: image.bitsStored = 32; break;
-    default:
-      return fail(fmt::format("'{}' has an unsupported pixel type (OpenCV depth {}); use unsigned 8- or 16-bit grey "
-                              "or float32 TIFF",
-                              path.filename().string(), grey.depth()));
-  }
-  image.cols = grey.cols;
-  image.rows = grey.rows;
+  image.bitsStored = decoded.sampleType == RasterSampleType::UInt8 ? 8 : decoded.sampleType == RasterSampleType::UInt16 ? 16 : 32;
+  image.cols = decoded.cols;
+  image.rows = decoded.rows;
   image.photometric = "MONOCHROME2";
   image.modality = modality;
   image.sourcePath = path.string();
-  image.pixels.resize(static_cast<std::size_t>(grey.cols) * grey.rows);
-  cv::Mat wrapped(grey.rows, grey.cols, CV_32F, image.pixels.data());
-  grey.convertTo(wrapped, CV_32F);
+  image.pixels = greyOf(decoded, name, warnings);
   if (!std::all_of(image.pixels.begin(), image.pixels.end(), [](float v) { return std::isfinite(v); })) {
     return fail(fmt::format("'{}' contains NaN or infinite pixel values", path.filename().string()));
   }
