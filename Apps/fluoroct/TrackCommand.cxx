@@ -159,7 +159,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                   {"roi_fraction", o.tracker.roiFraction},
                                   {"max_evaluations", o.tracker.maxEvaluations},
                                   {"refine_evaluations", o.tracker.refineEvaluations},
-                                  {"similarity_drop", o.tracker.similarityDrop},
+                                  {"dissimilarity_growth", o.tracker.dissimilarityGrowth},
                                   {"max_jump_mm", o.tracker.maxJump_mm},
                                   {"max_jump_deg", o.tracker.maxJump_deg}}}};
 }
@@ -334,8 +334,9 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
                       "After the per-frame search, an exact-DRR refinement with this cap on DRR sets (0 = none; for "
                       "--method transgraph)")
       ->capture_default_str();
-  command->add_option("--similarity-drop", options->tracker.similarityDrop,
-                      "Lost track: similarity below (1 - this) times the running level")
+  command->add_option("--dissimilarity-growth", options->tracker.dissimilarityGrowth,
+                      "Lost track: 1 - similarity above this times the reference (the smaller of the running level's "
+                      "and frame 0's, at least 0.005)")
       ->capture_default_str();
   command->add_option("--max-jump-mm", options->tracker.maxJump_mm,
                       "Lost track: bone centre more than this far from the prediction (mm)")

@@ -39,8 +39,8 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
     return fail(fmt::format("tracking step {} and tolerance {} must be positive with the tolerance below the step",
                             o.initialStep, o.tolerance));
   }
-  if (!(o.similarityDrop > 0.0 && o.similarityDrop < 1.0)) {
-    return fail(fmt::format("lost-track similarity drop must be in (0, 1), got {}", o.similarityDrop));
+  if (!(o.dissimilarityGrowth > 1.0 && std::isfinite(o.dissimilarityGrowth))) {
+    return fail(fmt::format("lost-track dissimilarity growth must be above 1, got {}", o.dissimilarityGrowth));
   }
   if (!(o.levelWeight > 0.0 && o.levelWeight <= 1.0)) {
     return fail(fmt::format("running-level weight must be in (0, 1], got {}", o.levelWeight));
@@ -145,7 +145,7 @@ Status CineTracker::runSchedule(const RegistrationSchedule& schedule, const Eige
 }
 
 bool CineTracker::withinBounds(const TrackedFrame& frame) const {
-  if (!(frame.similarity >= (1.0 - m_options.similarityDrop) * m_runningLevel)) return false;
+  if (!m_level.holds(frame.similarity)) return false;
   const Eigen::Isometry3d T_delta = frame.T_predicted_world_from_ct.inverse() * frame.T_world_from_ct;
   const Eigen::Vector3d& c = m_case->rotationCentre_ct_mm();
   const double move_mm = (frame.T_world_from_ct * c - frame.T_predicted_world_from_ct * c).norm();
@@ -173,7 +173,8 @@ Result<TrackedFrame> CineTracker::trackFirst(const Eigen::Isometry3d& T_initial,
   if (!similarity) return fail("frame 0: " + similarity.error());
   frame.drrs += objective.value().drrCount();
   frame.similarity = similarity.value();
-  m_runningLevel = frame.runningLevel = frame.similarity;
+  m_level = SimilarityLevel(frame.similarity, m_options.dissimilarityGrowth, m_options.levelWeight);
+  frame.runningLevel = frame.similarity;
   m_T_previous = frame.T_world_from_ct;
   m_T_beforePrevious.reset();
   m_nextIndex = 1;
@@ -200,7 +201,7 @@ Result<TrackedFrame> CineTracker::trackNext(const std::vector<XrayImage>& frameI
   const std::clock_t cpuStart = std::clock();
   TrackedFrame frame;
   frame.index = m_nextIndex;
-  frame.runningLevel = m_runningLevel;
+  frame.runningLevel = m_level.running();
   const Eigen::Vector3d& centre = m_case->rotationCentre_ct_mm();
   frame.T_predicted_world_from_ct = frame.T_world_from_ct =
       m_options.constantVelocity ? predictedPose(*m_T_previous, m_T_beforePrevious, centre) : *m_T_previous;
@@ -225,7 +226,7 @@ Result<TrackedFrame> CineTracker::trackNext(const std::vector<XrayImage>& frameI
     } else {
       m_T_beforePrevious = m_T_previous;
       m_T_previous = frame.T_world_from_ct;
-      m_runningLevel = (1.0 - m_options.levelWeight) * m_runningLevel + m_options.levelWeight * frame.similarity;
+      m_level.follow(frame.similarity);
     }
   }
   ++m_nextIndex;

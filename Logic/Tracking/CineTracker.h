@@ -4,8 +4,10 @@
 // (the default preset). Every later frame swaps each view's X-ray for the new frame (RegistrationCase::replaceXray),
 // starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre)
 // and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
-// run by Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose similarity falls below (1 - similarityDrop) times the
-// running level, or whose pose differs from the prediction by more than the jump limits, is re-registered from the
+// run by Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose
+// dissimilarity (1 - similarity) grows beyond dissimilarityGrowth times the reference (the smaller of the running level's
+// and frame 0's, so that a slow fall cannot drag the reference down with it), or whose pose differs from the prediction
+// by more than the jump limits, is re-registered from the
 // prediction with the global stage(s) of the first-frame schedule followed by the frame stage(s): it is `Recovered` when
 // that restores the level (and the jump limits hold), else `Lost` (the next frame then starts from the last trusted
 // pose without velocity).
@@ -23,6 +25,7 @@
 #include "Registration/Registration.h"
 #include "Registration/RegistrationCase.h"
 #include "Registration/RegistrationSchedule.h"
+#include "Tracking/SimilarityLevel.h"
 
 namespace fct {
 
@@ -69,7 +72,9 @@ struct CineTrackerOptions {
   /// DRR sets (for Transgraph tables, whose interpolation is too coarse for the final pose); 0: none.
   int refineEvaluations = 0;
   bool constantVelocity = true;   ///< predict previous pose + last inter-frame motion (false: previous pose)
-  double similarityDrop = 0.25;   ///< lost when similarity < (1 - similarityDrop) * running level, 0 < d < 1
+  /// Suspect when 1 - similarity > this x the reference dissimilarity: the smaller of 1 - running level and
+  /// 1 - frame 0's similarity, at least SimilarityLevel::kMinReferenceDissimilarity; > 1.
+  double dissimilarityGrowth = 2.0;
   double levelWeight = 0.2;       ///< weight of a new tracked frame in the running level (exponential mean), 0 < w <= 1
   double maxJump_mm = 8.0;        ///< lost when the rotation centre moves more than this from the prediction, mm
   double maxJump_deg = 6.0;       ///< lost when the rotation differs more than this from the prediction, deg
@@ -78,9 +83,10 @@ struct CineTrackerOptions {
 /// Tracks the bone through a sequence, frame by frame.
 class CineTracker {
  public:
+
   /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
   /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
-  /// outside (0, 1], a non-positive cap, step or tolerance, a drop outside (0, 1), a level weight outside (0, 1], a
+  /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside (0, 1], a
   /// non-positive jump limit, or an unknown first-frame preset.
   static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
 
@@ -115,7 +121,7 @@ class CineTracker {
   RegistrationSchedule m_frameSchedule;     ///< the frame stage (and its refinement)
   RegistrationSchedule m_recoverySchedule;  ///< the first-frame schedule's global stages, then the frame schedule
   int m_nextIndex = 0;
-  double m_runningLevel = 0.0;
+  SimilarityLevel m_level;  ///< started at frame 0's similarity at its registered pose
   std::optional<Eigen::Isometry3d> m_T_previous;       ///< last trusted pose
   std::optional<Eigen::Isometry3d> m_T_beforePrevious; ///< the trusted pose before it, for the velocity
 };

@@ -112,7 +112,7 @@ TEST(CineTracker, RejectsBadOptionsAndFrames) {
   ASSERT_FALSE(badLevel.ok());
   EXPECT_NE(badLevel.error().find("level 7"), std::string::npos) << badLevel.error();
   options = fastTracker();
-  options.similarityDrop = 1.5;
+  options.dissimilarityGrowth = 1.0;
   EXPECT_FALSE(fct::CineTracker::create(t.registrationCase, options).ok());
 
   auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
