@@ -74,7 +74,7 @@ struct CineTrackerOptions {
   bool constantVelocity = true;   ///< predict previous pose + last inter-frame motion (false: previous pose)
   /// Suspect when 1 - similarity > this x the reference dissimilarity: the smaller of 1 - running level and
   /// 1 - frame 0's similarity, at least SimilarityLevel::kMinReferenceDissimilarity; > 1.
-  double dissimilarityGrowth = 2.0;
+  double dissimilarityGrowth = 1.75;
   double levelWeight = 0.2;       ///< weight of a new tracked frame in the running level (exponential mean), 0 < w <= 1
   double maxJump_mm = 8.0;        ///< lost when the rotation centre moves more than this from the prediction, mm
   double maxJump_deg = 6.0;       ///< lost when the rotation differs more than this from the prediction, deg
