@@ -1,5 +1,6 @@
 #pragma once
-// XrayImageFileReader: X-ray images from plain PNG and TIFF files (no geometry; the camera comes from a view file).
+// XrayImageFileReader: X-ray images from plain PNG and TIFF files (decoded by PngCodec and TiffCodec: libpng, libtiff;
+// no geometry: the camera comes from a view file).
 
 #include <filesystem>
 
