@@ -35,6 +35,9 @@ bool hasSignature(std::ifstream& file, const std::string& modality) {
 /// otherwise ask for gigabytes.
 constexpr std::uint64_t kMaxImageSide = 16384;
 constexpr std::uint64_t kMaxImagePixels = std::uint64_t{1} << 25;  // 33.5 million: 5792 x 5792
+/// The largest file read into memory for decoding: the largest image as uncompressed float32 RGBA (512 MiB) with room
+/// for the file's own structure. A larger file is not an X-ray image of an accepted size, whatever its header says.
+constexpr std::uint64_t kMaxFileBytes = std::uint64_t{1} << 30;
 
 /// Width and height in pixels as an image file's header declares them.
 struct DeclaredSize {
@@ -148,9 +151,16 @@ Result<XrayImage> XrayImageFileReader::read(const std::filesystem::path& path) {
                             "a side and {} pixels in all (a damaged file, or not an X-ray image?)",
                             path.filename().string(), size->cols, size->rows, kMaxImageSide, kMaxImagePixels));
   }
+  const std::uintmax_t fileBytes = std::filesystem::file_size(path, ec);
+  if (ec || fileBytes > kMaxFileBytes) {
+    return fail(ec ? fmt::format("cannot read '{}': {}", path.string(), ec.message())
+                   : fmt::format("'{}' is {} bytes, more than any X-ray image FluoroCT reads ({} bytes at most; a damaged "
+                                 "file, or not an X-ray image?)",
+                                 path.filename().string(), fileBytes, kMaxFileBytes));
+  }
   header.clear();
-  header.seekg(0, std::ios::end);
-  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(header.tellg(), 0)), '\0');
+  header.seekg(0);
+  std::string bytes(static_cast<std::size_t>(fileBytes), '\0');
   header.seekg(0);
   if (!header.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) {
     return fail(fmt::format("cannot read '{}': the file could not be read to its end", path.string()));

@@ -165,3 +165,15 @@ TEST(XrayImageFileReader, RefusesAnImageWhoseHeaderDeclaresMoreThanAnyDetectorBe
   ASSERT_FALSE(wide.ok());
   EXPECT_NE(wide.error().find("'wide.png' declares an image of 70000 x 3 pixels"), std::string::npos) << wide.error();
 }
+
+TEST(XrayImageFileReader, RefusesAFileLargerThanAnyAcceptedImageBeforeReadingIt) {
+  // A 2 GiB file (sparse: no disk is used) that starts as a valid TIFF whose directory cannot be found.
+  const auto path = fct::test::scratchDir() / "huge.tif";
+  std::ofstream(path, std::ios::binary) << std::string("II*\0\xff\xff\xff\x7f", 8);
+  std::filesystem::resize_file(path, std::uintmax_t{1} << 31);
+  const auto huge = XrayImageFileReader::read(path);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_NE(huge.error().find("'huge.tif' is 2147483648 bytes, more than any X-ray image"), std::string::npos)
+      << huge.error();
+  std::filesystem::remove(path);
+}
