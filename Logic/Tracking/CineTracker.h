@@ -6,11 +6,10 @@
 // and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
 // run by Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose
 // dissimilarity (1 - similarity) grows beyond dissimilarityGrowth times the reference (the smaller of the running level's
-// and frame 0's, so that a slow fall cannot drag the reference down with it), or whose pose differs from the prediction
-// by more than the jump limits, is re-registered from the
-// prediction with the global stage(s) of the first-frame schedule followed by the frame stage(s): it is `Recovered` when
-// that restores the level (and the jump limits hold), else `Lost` (the next frame then starts from the last trusted
-// pose without velocity).
+// and frame 0's, so that a slow fall cannot drag the reference down with it; SimilarityLevel), or whose pose differs
+// from the prediction by more than the jump limits, is re-registered from the prediction with the global stage(s) of
+// the first-frame schedule followed by the frame stage(s): it is `Recovered` when that restores the level (and the jump
+// limits hold), else `Lost` (the next frame then starts from the last trusted pose without velocity).
 
 #include <Eigen/Geometry>
 
@@ -83,11 +82,10 @@ struct CineTrackerOptions {
 /// Tracks the bone through a sequence, frame by frame.
 class CineTracker {
  public:
-
   /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
   /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
-  /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside (0, 1], a
-  /// non-positive jump limit, or an unknown first-frame preset.
+  /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside
+  /// (0, 1], a non-positive jump limit, or an unknown first-frame preset.
   static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
 
   /// Registers frame 0 (the case's current images) with the first-frame schedule from T_initial and sets the running

@@ -13,6 +13,7 @@ class SimilarityLevel {
   /// matches differ only by noise).
   static constexpr double kMinReferenceDissimilarity = 0.005;
 
+  /// A placeholder until frame 0's similarity is known (CineTracker replaces it in trackFirst, before any judgement).
   SimilarityLevel() = default;
   /// Starts both levels at frame 0's similarity; `growth` (> 1) is the tolerated growth of the dissimilarity, `weight`
   /// (0 < w <= 1) a new frame's weight in the running level. Callers check the ranges (CineTracker::create).
@@ -28,10 +29,10 @@ class SimilarityLevel {
   double referenceDissimilarity() const;
 
  private:
-  double m_first = 1.0;
-  double m_running = 1.0;
-  double m_growth = 2.0;
-  double m_weight = 0.2;
+  double m_first = 0.0;
+  double m_running = 0.0;
+  double m_growth = 1.0;
+  double m_weight = 1.0;
 };
 
 }  // namespace fct

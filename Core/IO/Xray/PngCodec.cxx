@@ -119,7 +119,7 @@ Result<std::string> encode(const std::uint8_t* pixels, int cols, int rows, int b
 
 }  // namespace
 
-Result<DecodedRaster> PngCodec::decode(std::string_view bytes, std::uint32_t maxSide) {
+Result<DecodedRaster> PngCodec::decode(std::string_view bytes, std::uint32_t maxSide, std::uint64_t maxPixels) {
   PngErrorText error;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &error, onPngError, onPngWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -132,38 +132,38 @@ Result<DecodedRaster> PngCodec::decode(std::string_view bytes, std::uint32_t max
   png_set_user_limits(png, maxSide, maxSide);
   PngLayout layout{};
   DecodedRaster raster;
+  std::string refusal;
   bool ok = readHeader(png, info, &layout);
-  if (ok) {
+  if (ok && std::uint64_t{layout.cols} * layout.rows > maxPixels) {
+    refusal = fmt::format("the PNG declares {} x {} pixels, more than FluoroCT decodes ({} at most)", layout.cols,
+                          layout.rows, maxPixels);
+  } else if (ok) {
     std::vector<png_byte> buffer(layout.rowBytes * layout.rows);
     std::vector<png_bytep> rowPointers(layout.rows);
     for (png_uint_32 r = 0; r < layout.rows; ++r) rowPointers[r] = buffer.data() + r * layout.rowBytes;
     ok = readRows(png, info, rowPointers.data());
     if (ok) {
+      // After the transforms the rows hold exactly cols x channels samples of 1 or 2 bytes, back to back.
       raster.cols = static_cast<int>(layout.cols);
       raster.rows = static_cast<int>(layout.rows);
       raster.channels = layout.channels;
-      const std::size_t count = std::size_t{layout.cols} * layout.rows * static_cast<std::size_t>(layout.channels);
-      raster.samples.resize(count);
+      raster.sampleType = layout.bitDepth == 16 ? RasterSampleType::UInt16 : RasterSampleType::UInt8;
+      raster.samples.resize(std::size_t{layout.cols} * layout.rows * static_cast<std::size_t>(layout.channels));
       if (layout.bitDepth == 16) {
-        raster.sampleType = RasterSampleType::UInt16;
-        std::vector<std::uint16_t> wide(count);
-        for (png_uint_32 r = 0; r < layout.rows; ++r) {
-          std::memcpy(wide.data() + std::size_t{r} * layout.cols * layout.channels, rowPointers[r],
-                      std::size_t{layout.cols} * layout.channels * 2);
+        for (std::size_t n = 0; n < raster.samples.size(); ++n) {
+          std::uint16_t wide;
+          std::memcpy(&wide, buffer.data() + 2 * n, 2);
+          raster.samples[n] = wide;
         }
-        std::copy(wide.begin(), wide.end(), raster.samples.begin());
       } else {
-        raster.sampleType = RasterSampleType::UInt8;
-        for (png_uint_32 r = 0; r < layout.rows; ++r) {
-          std::copy_n(rowPointers[r], std::size_t{layout.cols} * layout.channels,
-                      raster.samples.begin() + static_cast<std::ptrdiff_t>(std::size_t{r} * layout.cols * layout.channels));
-        }
+        std::copy_n(buffer.begin(), raster.samples.size(), raster.samples.begin());
       }
       if (layout.colourType == PNG_COLOR_TYPE_PALETTE) raster.notes.push_back("palette expanded to RGB");
     }
   }
   png_destroy_read_struct(&png, &info, nullptr);
-  if (!ok) return fail(fmt::format("libpng: {}", error.message));
+  if (!refusal.empty()) return fail(refusal);
+  if (!ok) return fail(fmt::format("libpng: {} (damaged or truncated PNG data)", error.message));
   return raster;
 }
 

@@ -14,9 +14,9 @@ namespace fct {
 class PngCodec {
  public:
   /// Decodes a whole PNG held in `bytes`: grey, grey + alpha, RGB, RGBA (8 or 16 bits) or palette (expanded to RGB);
-  /// grey of 1, 2 or 4 bits is widened to 8. Fails with libpng's reason on damaged or truncated data, or when a side
-  /// exceeds `maxSide` pixels.
-  static Result<DecodedRaster> decode(std::string_view bytes, std::uint32_t maxSide);
+  /// grey of 1, 2 or 4 bits is widened to 8. Fails with libpng's reason on damaged or truncated data, and before
+  /// allocating the image when a side exceeds `maxSide` pixels or the image `maxPixels`.
+  static Result<DecodedRaster> decode(std::string_view bytes, std::uint32_t maxSide, std::uint64_t maxPixels);
 
   /// Encodes rows*cols 16-bit grey values (row-major) as a PNG; fails only if libpng does.
   static Result<std::string> encodeGrey16(const std::uint16_t* pixels, int cols, int rows);

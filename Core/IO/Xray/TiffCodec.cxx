@@ -75,7 +75,8 @@ struct TiffCloser {
 };
 using TiffHandle = std::unique_ptr<TIFF, TiffCloser>;
 
-/// Opens `stream` for reading ("r") or writing ("w") with FluoroCT's handlers and memory limit.
+/// Opens `stream` for reading ("r") or writing ("w") with FluoroCT's handlers and a limit on libtiff's single
+/// allocations (0: none).
 TiffHandle open(MemoryStream& stream, const char* mode, std::string& error, std::int64_t maxBytes) {
   TIFFOpenOptions* options = TIFFOpenOptionsAlloc();
   if (!options) return nullptr;
@@ -116,7 +117,7 @@ struct TiffLayout {
   int fileSamples = 1;   ///< samples read per pixel (1 for a palette index)
 };
 
-Result<TiffLayout> readLayout(TIFF* tif, std::int64_t maxBytes) {
+Result<TiffLayout> readLayout(TIFF* tif, std::uint32_t maxSide, std::uint64_t maxPixels) {
   TiffLayout l;
   if (!TIFFGetField(tif, TIFFTAG_IMAGEWIDTH, &l.cols) || !TIFFGetField(tif, TIFFTAG_IMAGELENGTH, &l.rows) || l.cols == 0 ||
       l.rows == 0) {
@@ -166,9 +167,9 @@ Result<TiffLayout> readLayout(TIFF* tif, std::int64_t maxBytes) {
                               "space); use grey or RGB",
                               l.photometric));
   }
-  if (std::uint64_t{l.cols} * l.rows * static_cast<std::uint64_t>(l.channels) * sizeof(float) >
-      static_cast<std::uint64_t>(maxBytes)) {
-    return fail(fmt::format("the TIFF declares {} x {} pixels, more than FluoroCT decodes", l.cols, l.rows));
+  if (l.cols > maxSide || l.rows > maxSide || std::uint64_t{l.cols} * l.rows > maxPixels) {
+    return fail(fmt::format("the TIFF declares {} x {} pixels, more than FluoroCT decodes ({} a side, {} in all at most)",
+                            l.cols, l.rows, maxSide, maxPixels));
   }
   return l;
 }
@@ -191,7 +192,10 @@ Status readPixels(TIFF* tif, const TiffLayout& l, DecodedRaster& raster, const s
   const int planes = planar ? l.fileSamples : 1;
   const int stride = planar ? 1 : l.samplesPerPixel;   // samples per pixel in one decoded buffer
   const int samples = planar ? 1 : l.fileSamples;      // of which the raster keeps
-  auto failed = [&](const char* what) { return fail(fmt::format("cannot decode the {}: {}", what, error.empty() ? "libtiff gave no reason" : error)); };
+  auto failed = [&](const char* what) {
+    return fail(fmt::format("libtiff cannot decode the {}: {} (damaged or truncated TIFF data)", what,
+                            error.empty() ? "no reason given" : error));
+  };
   if (TIFFIsTiled(tif)) {
     std::uint32_t tileCols = 0, tileRows = 0;
     TIFFGetField(tif, TIFFTAG_TILEWIDTH, &tileCols);
@@ -249,13 +253,16 @@ Status expandPalette(TIFF* tif, DecodedRaster& raster) {
 
 }  // namespace
 
-Result<DecodedRaster> TiffCodec::decode(std::string_view bytes, std::int64_t maxBytes) {
+Result<DecodedRaster> TiffCodec::decode(std::string_view bytes, std::uint32_t maxSide, std::uint64_t maxPixels) {
   MemoryStream stream;
   stream.input = bytes;
   std::string error;
-  TiffHandle tif = open(stream, "rm", error, maxBytes);
-  if (!tif) return fail(fmt::format("libtiff: {}", error.empty() ? "not a readable TIFF" : error));
-  auto layout = readLayout(tif.get(), maxBytes);
+  const auto maxAllocation = static_cast<std::int64_t>(std::min<std::uint64_t>(maxPixels, std::uint64_t{1} << 40) * 16);
+  TiffHandle tif = open(stream, "rm", error, maxAllocation);
+  if (!tif) {
+    return fail(fmt::format("libtiff: {} (damaged or truncated TIFF data)", error.empty() ? "not a readable TIFF" : error));
+  }
+  auto layout = readLayout(tif.get(), maxSide, maxPixels);
   if (!layout) return fail(layout.error());
   const TiffLayout& l = layout.value();
   DecodedRaster raster;

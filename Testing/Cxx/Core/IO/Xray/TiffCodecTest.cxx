@@ -19,7 +19,8 @@ using fct::TiffCodec;
 
 namespace {
 
-constexpr std::int64_t kMaxBytes = std::int64_t{1} << 28;
+constexpr std::uint32_t kMaxSide = 16384;
+constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 25;
 
 /// How the test writes a TIFF with libtiff itself: the layouts a detector or an image tool may produce.
 struct TiffRecipe {
@@ -110,7 +111,7 @@ TEST(TiffCodec, Float32RoundTripsAndOpenCvReadsIt) {
   for (std::size_t n = 0; n < pixels.size(); ++n) pixels[n] = 0.37f * static_cast<float>(n) - 9.5f;
   auto encoded = TiffCodec::encodeFloat32(pixels.data(), 11, 6);
   ASSERT_TRUE(encoded) << encoded.error();
-  auto decoded = TiffCodec::decode(encoded.value(), kMaxBytes);
+  auto decoded = TiffCodec::decode(encoded.value(), kMaxSide, kMaxPixels);
   ASSERT_TRUE(decoded) << decoded.error();
   EXPECT_EQ(decoded.value().cols, 11);
   EXPECT_EQ(decoded.value().rows, 6);
@@ -135,7 +136,7 @@ TEST(TiffCodec, ReadsStripsTilesPlanesAndCompressionAlike) {
         recipe.compression = compression;
         recipe.tiled = tiled;
         const std::string label = fmt::format("tiled {} planar {} compression {}", tiled, planar, compression);
-        auto decoded = TiffCodec::decode(writeTiff(recipe, 37, 21), kMaxBytes);
+        auto decoded = TiffCodec::decode(writeTiff(recipe, 37, 21), kMaxSide, kMaxPixels);
         ASSERT_TRUE(decoded) << label << ": " << decoded.error();
         ASSERT_EQ(decoded.value().channels, 3) << label;
         EXPECT_EQ(decoded.value().sampleType, RasterSampleType::UInt16) << label;
@@ -156,7 +157,7 @@ TEST(TiffCodec, ExpandsPalettesAndFlipsWhiteIsZeroWithANote) {
   TiffRecipe palette;
   palette.bits = 8;
   palette.photometric = PHOTOMETRIC_PALETTE;
-  auto colours = TiffCodec::decode(writeTiff(palette, 9, 4), kMaxBytes);
+  auto colours = TiffCodec::decode(writeTiff(palette, 9, 4), kMaxSide, kMaxPixels);
   ASSERT_TRUE(colours) << colours.error();
   ASSERT_EQ(colours.value().channels, 3);
   const float index = static_cast<float>(patternValue(2, 3, 0, 8));
@@ -168,7 +169,7 @@ TEST(TiffCodec, ExpandsPalettesAndFlipsWhiteIsZeroWithANote) {
 
   TiffRecipe whiteIsZero;
   whiteIsZero.photometric = PHOTOMETRIC_MINISWHITE;
-  auto flipped = TiffCodec::decode(writeTiff(whiteIsZero, 9, 4), kMaxBytes);
+  auto flipped = TiffCodec::decode(writeTiff(whiteIsZero, 9, 4), kMaxSide, kMaxPixels);
   ASSERT_TRUE(flipped) << flipped.error();
   EXPECT_EQ(flipped.value().samples[3 * 9 + 2], 65535.0f - static_cast<float>(patternValue(2, 3, 0, 16)));
   ASSERT_EQ(flipped.value().notes.size(), 1u);
@@ -179,7 +180,7 @@ TEST(TiffCodec, RejectsUnsupportedTypesAndDamagedDataWithAReason) {
   const cv::Mat signedPixels(4, 4, CV_16S, cv::Scalar(-5));
   std::vector<unsigned char> bytes;
   ASSERT_TRUE(cv::imencode(".tif", signedPixels, bytes));
-  auto signedImage = TiffCodec::decode(std::string(bytes.begin(), bytes.end()), kMaxBytes);
+  auto signedImage = TiffCodec::decode(std::string(bytes.begin(), bytes.end()), kMaxSide, kMaxPixels);
   ASSERT_FALSE(signedImage);
   EXPECT_NE(signedImage.error().find("unsupported pixel type (16-bit signed integer samples)"), std::string::npos)
       << signedImage.error();
@@ -189,10 +190,10 @@ TEST(TiffCodec, RejectsUnsupportedTypesAndDamagedDataWithAReason) {
   compressed.tiled = true;
   const std::string whole = writeTiff(compressed, 64, 64);
   for (const std::size_t keep : {std::size_t{0}, std::size_t{7}, std::size_t{200}, whole.size() / 2}) {
-    auto truncated = TiffCodec::decode(std::string_view(whole).substr(0, keep), kMaxBytes);
+    auto truncated = TiffCodec::decode(std::string_view(whole).substr(0, keep), kMaxSide, kMaxPixels);
     EXPECT_FALSE(truncated) << "kept " << keep << " of " << whole.size() << " bytes";
   }
-  auto tooLarge = TiffCodec::decode(whole, 64 * 64 * 4 - 1);
+  auto tooLarge = TiffCodec::decode(whole, kMaxSide, 64 * 64 - 1);
   ASSERT_FALSE(tooLarge);
   EXPECT_NE(tooLarge.error().find("64 x 64"), std::string::npos) << tooLarge.error();
 }
