@@ -5,8 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <vector>
+#include <utility>
 
 #include "Drr/DrrRayGeometry.h"
 
@@ -39,38 +38,82 @@ std::vector<std::uint8_t> sliceFootprint(const DrrVolume& volume, int k, const E
   return tissue;
 }
 
-/// True when the segment a + t·d, t in [t0, t1] (ijk), passes over a footprint pixel (sampled every half voxel).
-bool crossesFootprint(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double t0, double t1,
-                      const std::vector<std::uint8_t>& footprint, int ni, int nj) {
-  if (!(t1 > t0)) return false;
-  const double inPlane = d.head<2>().norm() * (t1 - t0);
-  const int samples = std::max(2, static_cast<int>(std::ceil(2.0 * inPlane)) + 1);
-  for (int q = 0; q < samples; ++q) {
-    const Eigen::Vector3d p = a + d * (t0 + (t1 - t0) * q / (samples - 1));
-    const int i = std::clamp(static_cast<int>(std::lround(p.x())), 0, ni - 1);
-    const int j = std::clamp(static_cast<int>(std::lround(p.y())), 0, nj - 1);
-    if (footprint[static_cast<std::size_t>(j) * ni + i]) return true;
+/// Nearest index of a coordinate x >= -0.5 (the ray is clipped to the volume's prism), as std::lround.
+int nearest(double x) { return static_cast<int>(std::floor(x + 0.5)); }
+
+/// Narrows [qFirst, qLast] (sample indices; sample q at t0 + step·q) to the samples whose coordinate a + d·t along
+/// one axis lies in [low, high].
+void narrowToSlab(double a, double d, double t0, double step, double low, double high, int& qFirst, int& qLast) {
+  const double slope = d * step;  // coordinate change per sample
+  const double start = a + d * t0;
+  if (slope == 0.0) {
+    if (start < low || start > high) qLast = qFirst - 1;
+    return;
   }
-  return false;
+  double q0 = (low - start) / slope, q1 = (high - start) / slope;
+  if (q0 > q1) std::swap(q0, q1);
+  // Clamped to the current range before the conversion, which a nearly parallel ray would overflow.
+  qFirst = static_cast<int>(std::clamp(std::floor(q0), double(qFirst), double(qLast) + 1.0));
+  qLast = static_cast<int>(std::clamp(std::ceil(q1), double(qFirst) - 1.0, double(qLast)));
 }
 
 }  // namespace
 
-Result<ValidMask> CutFaceRayMask::compute(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct,
-                                          const DrrVolume& volume, double margin_mm) {
+Result<CutFaceRayMask> CutFaceRayMask::create(const DrrVolume& volume, double margin_mm) {
   if (!(std::isfinite(margin_mm) && margin_mm >= 0.0 && margin_mm <= 500.0)) {
     return fail(fmt::format("cut-face margin must be 0..500 mm, got {}", margin_mm));
   }
-  const DrrRayGeometry geometry(camera, T_world_from_ct, volume.T_ijk_from_ct());
-  const Eigen::Vector3i& dims = volume.values().dims();
-  const Eigen::Vector3d margin_ijk = margin_mm * volume.values().spacing_mm().cwiseInverse();
-  const Eigen::Vector2i grow(static_cast<int>(std::ceil(margin_ijk.x())), static_cast<int>(std::ceil(margin_ijk.y())));
-  const std::vector<std::uint8_t> lowFace = sliceFootprint(volume, 0, grow);
-  const std::vector<std::uint8_t> highFace = sliceFootprint(volume, dims.z() - 1, grow);
+  CutFaceRayMask mask;
+  mask.m_T_ijk_from_ct = volume.T_ijk_from_ct();
+  mask.m_dims = volume.values().dims();
+  mask.m_margin_ijk = margin_mm * volume.values().spacing_mm().cwiseInverse();
+  const Eigen::Vector2i grow(static_cast<int>(std::ceil(mask.m_margin_ijk.x())),
+                             static_cast<int>(std::ceil(mask.m_margin_ijk.y())));
+  for (auto [face, k] : {std::make_pair(&mask.m_low, 0), std::make_pair(&mask.m_high, mask.m_dims.z() - 1)}) {
+    face->footprint = sliceFootprint(volume, k, grow);
+    face->iMin = mask.m_dims.x();
+    face->jMin = mask.m_dims.y();
+    for (int j = 0; j < mask.m_dims.y(); ++j)
+      for (int i = 0; i < mask.m_dims.x(); ++i) {
+        if (!face->footprint[static_cast<std::size_t>(j) * mask.m_dims.x() + i]) continue;
+        face->iMin = std::min(face->iMin, i);
+        face->iMax = std::max(face->iMax, i);
+        face->jMin = std::min(face->jMin, j);
+        face->jMax = std::max(face->jMax, j);
+      }
+  }
+  return mask;
+}
+
+bool CutFaceRayMask::crosses(const Face& face, const Eigen::Vector3d& a, const Eigen::Vector3d& d, double t0,
+                             double t1) const {
+  if (!(t1 > t0) || face.iMax < face.iMin) return false;
+  const int ni = m_dims.x(), nj = m_dims.y();
+  const double inPlane = d.head<2>().norm() * (t1 - t0);
+  const int samples = std::max(2, static_cast<int>(std::ceil(2.0 * inPlane)) + 1);
+  const double step = (t1 - t0) / (samples - 1);
+  // Only samples within a voxel of the footprint's bounding box can round into it (the clamp to the volume maps
+  // nothing from outside the box into it either).
+  int qFirst = 0, qLast = samples - 1;
+  narrowToSlab(a.x(), d.x(), t0, step, face.iMin - 1.0, face.iMax + 1.0, qFirst, qLast);
+  narrowToSlab(a.y(), d.y(), t0, step, face.jMin - 1.0, face.jMax + 1.0, qFirst, qLast);
+  qFirst = std::max(qFirst, 0);
+  qLast = std::min(qLast, samples - 1);
+  for (int q = qFirst; q <= qLast; ++q) {
+    const Eigen::Vector3d p = a + d * (t0 + (t1 - t0) * q / (samples - 1));
+    const int i = std::clamp(nearest(p.x()), 0, ni - 1);
+    const int j = std::clamp(nearest(p.y()), 0, nj - 1);
+    if (face.footprint[static_cast<std::size_t>(j) * ni + i]) return true;
+  }
+  return false;
+}
+
+ValidMask CutFaceRayMask::compute(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct) const {
+  const DrrRayGeometry geometry(camera, T_world_from_ct, m_T_ijk_from_ct);
   constexpr double kEndless = 1e12;  // the in-plane box continues along k without end
   const Eigen::Vector3d prismLow(-0.5, -0.5, -kEndless);
-  const Eigen::Vector3d prismHigh(dims.x() - 0.5, dims.y() - 0.5, kEndless);
-  const double kLow = -0.5 + margin_ijk.z(), kHigh = dims.z() - 0.5 - margin_ijk.z();
+  const Eigen::Vector3d prismHigh(m_dims.x() - 0.5, m_dims.y() - 0.5, kEndless);
+  const double kLow = -0.5 + m_margin_ijk.z(), kHigh = m_dims.z() - 0.5 - m_margin_ijk.z();
   ValidMask mask = ValidMask::allValid(geometry.cols(), geometry.rows());
   tbb::parallel_for(0, geometry.rows(), [&](int row) {
     for (int col = 0; col < geometry.cols(); ++col) {
@@ -95,8 +138,7 @@ Result<ValidMask> CutFaceRayMask::compute(const Camera& camera, const Eigen::Iso
           highTo = std::min(t1, tAtHigh);
         }
       }
-      if (crossesFootprint(a, d, lowFrom, lowTo, lowFace, dims.x(), dims.y()) ||
-          crossesFootprint(a, d, highFrom, highTo, highFace, dims.x(), dims.y())) {
+      if (crosses(m_low, a, d, lowFrom, lowTo) || crosses(m_high, a, d, highFrom, highTo)) {
         mask.valid[static_cast<std::size_t>(row) * geometry.cols() + col] = 0;
       }
     }

@@ -45,7 +45,11 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   if (!(options.cutFaceMargin_mm <= 500.0)) {  // also NaN
     return fail(fmt::format("cut-face margin must be at most 500 mm (negative: off), got {}", options.cutFaceMargin_mm));
   }
-  result.m_cutFaceMargin_mm = options.cutFaceMargin_mm;
+  if (options.cutFaceMargin_mm >= 0.0) {
+    auto cutFaces = CutFaceRayMask::create(*result.m_drrVolume, options.cutFaceMargin_mm);
+    if (!cutFaces) return fail(cutFaces.error());
+    result.m_cutFaces = std::move(cutFaces).value();
+  }
 
   for (std::size_t v = 0; v < views.size(); ++v) {
     const RegistrationView& view = views[v];
@@ -222,9 +226,9 @@ Result<ValidMask> RegistrationCase::cutFaceMask(std::size_t v, int level,
                                                 const Eigen::Isometry3d& T_world_from_ct) const {
   if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
   const PyramidLevel& pyramidLevel = m_views[v].prepared.pyramid.level(level);
-  if (m_cutFaceMargin_mm < 0.0) return ValidMask::allValid(pyramidLevel.image.cols, pyramidLevel.image.rows);
+  if (!m_cutFaces) return ValidMask::allValid(pyramidLevel.image.cols, pyramidLevel.image.rows);
   if (!pyramidLevel.camera) return fail(fmt::format("view '{}', level {}: no camera", m_views[v].name, level));
-  return CutFaceRayMask::compute(*pyramidLevel.camera, T_world_from_ct, *m_drrVolume, m_cutFaceMargin_mm);
+  return m_cutFaces->compute(*pyramidLevel.camera, T_world_from_ct);
 }
 
 Status RegistrationCase::checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const {

@@ -23,6 +23,7 @@
 
 #include "Base/ProgressMonitor.h"
 #include "Base/Result.h"
+#include "Drr/CutFaceRayMask.h"
 #include "Drr/DrrRenderer.h"
 #include "Drr/DrrRendererFactory.h"
 #include "Drr/TransgraphRenderer.h"
@@ -162,7 +163,7 @@ class RegistrationCase {
   std::map<std::array<int, 3>, std::shared_ptr<const DrrRenderer>> m_coarseRenderers;  ///< by CT block size
   DrrRendererOptions m_drrOptions;
   bool m_viewRenderersReady = true;
-  double m_cutFaceMargin_mm = -1.0;
+  std::optional<CutFaceRayMask> m_cutFaces;  ///< the CT's cut faces with the margin; none when it is off
   double m_viewRendererSetup_s = 0.0;
   std::vector<View> m_views;
   std::optional<BoneSurface> m_bone;

@@ -42,26 +42,27 @@ bool validAt(const fct::ValidMask& mask, const fct::Camera& camera, const Eigen:
 
 TEST(CutFaceRayMask, LeavesOutRaysOverThePatientBeyondACutFace) {
   const fct::Camera camera = apCamera();
-  auto mask = fct::CutFaceRayMask::compute(camera, Eigen::Isometry3d::Identity(), cylinderCt(false), 5.0);
-  ASSERT_TRUE(mask.ok()) << mask.error();
-  EXPECT_TRUE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 0)));         // through the middle of the slab
-  EXPECT_TRUE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 10)));        // 10 mm inside the top face
-  EXPECT_FALSE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 18)));       // within the margin of it
-  EXPECT_FALSE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, 35)));       // beyond it, over the cylinder
-  EXPECT_FALSE(validAt(mask.value(), camera, Eigen::Vector3d(0, 0, -35)));      // beyond the bottom face
-  EXPECT_TRUE(validAt(mask.value(), camera, Eigen::Vector3d(40, 0, 35)));       // beside the cylinder's footprint
+  auto cutFaces = fct::CutFaceRayMask::create(cylinderCt(false), 5.0);
+  ASSERT_TRUE(cutFaces.ok()) << cutFaces.error();
+  const fct::ValidMask mask = cutFaces.value().compute(camera, Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(validAt(mask, camera, Eigen::Vector3d(0, 0, 0)));         // through the middle of the slab
+  EXPECT_TRUE(validAt(mask, camera, Eigen::Vector3d(0, 0, 10)));        // 10 mm inside the top face
+  EXPECT_FALSE(validAt(mask, camera, Eigen::Vector3d(0, 0, 18)));       // within the margin of it
+  EXPECT_FALSE(validAt(mask, camera, Eigen::Vector3d(0, 0, 35)));       // beyond it, over the cylinder
+  EXPECT_FALSE(validAt(mask, camera, Eigen::Vector3d(0, 0, -35)));      // beyond the bottom face
+  EXPECT_TRUE(validAt(mask, camera, Eigen::Vector3d(40, 0, 35)));       // beside the cylinder's footprint
 }
 
 TEST(CutFaceRayMask, KeepsEveryRayWhenTheEndSlicesHoldNoPatient) {
   const fct::Camera camera = apCamera();
   const fct::ValidMask mask =
-      fct::CutFaceRayMask::compute(camera, Eigen::Isometry3d::Identity(), cylinderCt(true), 5.0).value();
+      fct::CutFaceRayMask::create(cylinderCt(true), 5.0).value().compute(camera, Eigen::Isometry3d::Identity());
   EXPECT_EQ(mask.validCount(), static_cast<std::size_t>(128 * 128));
 }
 
 TEST(CutFaceRayMask, RejectsABadMargin) {
   const fct::DrrVolume volume = cylinderCt(false);
   for (double margin : {-1.0, 600.0, std::numeric_limits<double>::quiet_NaN()}) {
-    EXPECT_FALSE(fct::CutFaceRayMask::compute(apCamera(), Eigen::Isometry3d::Identity(), volume, margin).ok()) << margin;
+    EXPECT_FALSE(fct::CutFaceRayMask::create(volume, margin).ok()) << margin;
   }
 }
