@@ -7,6 +7,9 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
+#include <tbb/parallel_invoke.h>
+
+#include "XrayPrep/DiscErosion.h"
 
 namespace fct {
 
@@ -118,14 +121,14 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
     const cv::Mat valid(rows, cols, CV_8U, const_cast<std::uint8_t*>(mask.valid.data()));
     cv::Mat p = image.clone();
     p.setTo(cv::Scalar(kHigh), valid == 0);
-    const cv::Mat wideExcess = image - validOpening(p, wideWindow_px);
-    const cv::Mat narrowBackground = validOpening(p, narrowWindow_px);
+    // The wide and narrow surroundings and the low side of the surroundings (the erosion over a disc; invalid pixels
+    // never win it) are independent: made side by side.
+    cv::Mat wideBackground, narrowBackground, lowSide;
+    tbb::parallel_invoke([&] { wideBackground = validOpening(p, wideWindow_px); },
+                         [&] { narrowBackground = validOpening(p, narrowWindow_px); },
+                         [&] { lowSide = discErosion(p, contrastWindow_px | 1, kHigh); });
+    const cv::Mat wideExcess = image - wideBackground;
     const cv::Mat narrowExcess = image - narrowBackground;
-    // The low side of the surroundings: the erosion over a disc (invalid pixels never win it).
-    cv::Mat lowSide;
-    const int disc = contrastWindow_px | 1;
-    cv::erode(p, lowSide, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(disc, disc)), cv::Point(-1, -1), 1,
-              cv::BORDER_CONSTANT, cv::Scalar(kHigh));
     cv::Mat contrast = narrowBackground - lowSide;
     contrast.setTo(cv::Scalar(0.0f), lowSide == kHigh);
 
