@@ -302,7 +302,7 @@ void StudioDocument::prepareCaseInBackground() {
   m_preparation = new CasePreparation(m_ct, m_views, options.value(), this);
   connect(m_preparation, &CasePreparation::progressed, this, &StudioDocument::casePreparationProgressed);
   connect(m_preparation, &CasePreparation::finished, this, [this] {
-    if (m_preparation) adoptPreparation();
+    if (m_preparation) (void)adoptPreparation();  // its failure reaches the views through casePreparationFinished
   });
 }
 

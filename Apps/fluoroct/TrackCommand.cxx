@@ -116,6 +116,7 @@ struct TrackRun {
   std::string drrMethod;
   bool cancelled = false;
   int frameCount = 0;  ///< frames in the sequence
+  int level = 0;       ///< pyramid level the frames after frame 0 were tracked at (the automatic level resolved)
 
   /// Frames after frame 0 per second of their tracking time (X-ray swap, search, recovery; not reading the files).
   double framesPerSecond() const {
@@ -155,7 +156,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                  {{"ct", o.ct},
                                   {"views", o.views},
                                   {"preset", o.preset},
-                                  {"level", o.tracker.level},
+                                  {"level", run.level},
                                   {"roi_fraction", o.tracker.roiFraction},
                                   {"max_evaluations", o.tracker.maxEvaluations},
                                   {"refine_evaluations", o.tracker.refineEvaluations},
@@ -234,9 +235,10 @@ void printSummary(const Options& o, const TrackRun& run) {
     if (i > 0) cpu.push_back(run.frames[i].cpuSeconds);
   }
   std::sort(cpu.begin(), cpu.end());
-  fmt::print("{} {} of {} frames: {} tracked, {} recovered, {} lost; {:.2f} frames/s after frame 0 (frame 0: {:.2f} s)",
+  fmt::print("{} {} of {} frames: {} tracked, {} recovered, {} lost; {:.2f} frames/s after frame 0 at pyramid level {} "
+             "(frame 0: {:.2f} s)",
              run.cancelled ? "cancelled after" : "tracked", run.frames.size(), run.frameCount, counts[0], counts[1],
-             counts[2], run.framesPerSecond(), run.frames.empty() ? 0.0 : run.frames.front().seconds);
+             counts[2], run.framesPerSecond(), run.level, run.frames.empty() ? 0.0 : run.frames.front().seconds);
   if (!cpu.empty()) fmt::print("; per-frame CPU median {:.3f} s, max {:.3f} s", cpu[cpu.size() / 2], cpu.back());
   fmt::print("; wrote {}\n", (fs::path(o.out) / "track.json").string());
 }
@@ -272,6 +274,7 @@ int runTrack(const Options& o) {
   run.centre_ct_mm = registrationCase.value().rotationCentre_ct_mm();
   run.drrMethod = std::string(DrrRendererFactory::methodName(method.value()));
   run.frameCount = in.frameCount;
+  run.level = tracker.value().options().level;
   auto first = tracker.value().trackFirst(in.initial.T_world_from_ct, cancel);
   if (!first) return reportError(first.error());
   run.frames.push_back(first.value());
@@ -322,8 +325,10 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   command->add_option("--transgraph-cache", options->transgraphCache,
                       "Folder of the transgraph table cache (default: ~/.cache/fluoroct/transgraph); 'none' disables it");
-  command->add_option("--level", options->tracker.level, "Pyramid level of the per-frame search (0 = full resolution, "
-                                                         "1 = 1:4 pixels)")
+  command->add_option("--level", options->tracker.level,
+                      fmt::format("Pyramid level of the per-frame search (0 = full resolution, 1 = 1:4 pixels, 2 = "
+                                  "1:16; -1 = automatic: the finest level at most {} px on its shorter side)",
+                                  CineTracker::kAutomaticLevelSide_px))
       ->capture_default_str();
   command->add_option("--roi-fraction", options->tracker.roiFraction,
                       "Fraction of the valid pixels in the per-frame dynamic ROIs")

@@ -254,8 +254,10 @@ std::vector<std::string> TrackingStudy::notes(const TrackingStudyDefinition& stu
       study.sourceToIsocentre_mm));
   out.push_back(fmt::format("frame 0: registered with the '{}' preset from a random pose at {:g} mm mean sTRE from its "
                             "truth; later frames: CineTracker defaults (constant-velocity prediction, local search on "
-                            "VLNC ROIs, recovery when lost); registration on the original CT, Siddon DRRs",
-                            study.preset, study.initialStre_mm));
+                            "VLNC ROIs of {:g} % of the valid pixels at the finest pyramid level at most {} px across, "
+                            "recovery when lost); registration on the original CT, Siddon DRRs",
+                            study.preset, study.initialStre_mm, 100.0 * CineTrackerOptions{}.roiFraction,
+                            CineTracker::kAutomaticLevelSide_px));
   return out;
 }
 

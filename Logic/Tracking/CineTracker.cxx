@@ -24,8 +24,8 @@ double cpuSecondsSince(std::clock_t start) { return static_cast<double>(std::clo
 /// Fails naming the option unless every tracker option is in range (the level is checked against the case).
 Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   if (o.level < 0 || o.level >= levelCount) {
-    return fail(fmt::format("tracking level {} does not exist; the case's pyramid has levels 0 to {}", o.level,
-                            levelCount - 1));
+    return fail(fmt::format("tracking level {} does not exist; the case's pyramid has levels 0 to {} (or -1: "
+                            "automatic)", o.level, levelCount - 1));
   }
   if (o.windowSize < 2 || o.windowSize > 64) return fail(fmt::format("tracking window must be 2..64 pixels, got {}", o.windowSize));
   if (!(o.roiFraction > 0.0 && o.roiFraction <= 1.0)) {
@@ -49,6 +49,21 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
     return fail(fmt::format("lost-track jump limits must be positive, got {} mm and {} deg", o.maxJump_mm, o.maxJump_deg));
   }
   return Ok{};
+}
+
+/// The automatic tracking level of the case: the finest whose image is at most kAutomaticLevelSide_px on its shorter
+/// side in every view, else the coarsest.
+int automaticLevel(const RegistrationCase& registrationCase) {
+  const int levels = registrationCase.levelCount();
+  for (int level = 0; level < levels; ++level) {
+    bool small = true;
+    for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
+      const FloatImage& image = registrationCase.prepared(v).pyramid.level(level).image;
+      small = small && std::min(image.cols, image.rows) <= CineTracker::kAutomaticLevelSide_px;
+    }
+    if (small) return level;
+  }
+  return levels - 1;
 }
 
 /// The frame schedule of the options: VLNC on dynamic ROIs at the tracking level with one local BOBYQA search, then
@@ -117,8 +132,9 @@ CineTracker::CineTracker(RegistrationCase& registrationCase, CineTrackerOptions 
 }
 
 Result<CineTracker> CineTracker::create(RegistrationCase& registrationCase, const CineTrackerOptions& options) {
-  if (Status valid = checkOptions(options, registrationCase.levelCount()); !valid) return fail(valid.error());
   CineTrackerOptions resolved = options;
+  if (resolved.level == CineTrackerOptions::kAutomaticLevel) resolved.level = automaticLevel(registrationCase);
+  if (Status valid = checkOptions(resolved, registrationCase.levelCount()); !valid) return fail(valid.error());
   if (resolved.firstFrame.schedule.stages.empty()) {
     auto schedule = RegistrationSchedule::builtin(RegistrationSchedule::kDefaultPreset);
     if (!schedule) return fail(schedule.error());

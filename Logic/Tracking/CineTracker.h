@@ -58,9 +58,13 @@ struct TrackedFrame {
 struct CineTrackerOptions {
   /// Frame 0's registration; an empty schedule means the default preset (RegistrationSchedule::kDefaultPreset).
   RegistrationOptions firstFrame;
-  int level = 1;                  ///< pyramid level of the frame stage (0 = full resolution, 1 = 1:4 pixels)
+  /// Pyramid level of the frame stage (0 = full resolution, 1 = 1:4 pixels, 2 = 1:16); kAutomaticLevel: the finest
+  /// level whose image is at most CineTracker::kAutomaticLevelSide_px on its shorter side in every view (the coarsest
+  /// level when none is), e.g. 2 for 512^2 and 1 for 256^2 detectors.
+  int level = kAutomaticLevel;
+  static constexpr int kAutomaticLevel = -1;
   int windowSize = 7;             ///< VLNC window, pixels of that level
-  double roiFraction = 0.06;      ///< dynamic ROIs: fraction of the valid pixels compared (0 < f <= 1)
+  double roiFraction = 0.2;       ///< dynamic ROIs: fraction of the valid pixels compared (0 < f <= 1)
   int maxEvaluations = 60;        ///< cap on DRR sets of the frame stage
   double initialStep = 0.5;       ///< BOBYQA's first trust radius, scaled units
   double tolerance = 0.05;        ///< BOBYQA's stopping step, scaled units
@@ -100,7 +104,10 @@ class CineTracker {
   /// The stages run on every frame after the first: the frame stage (VLNC on ROIs at the tracker's level, local
   /// BOBYQA) and, with refineEvaluations > 0, its exact-DRR refinement; frame similarities are the last stage's.
   const RegistrationSchedule& frameSchedule() const { return m_frameSchedule; }
-  /// The options the tracker runs with (the first-frame schedule resolved).
+  /// The shorter image side, in pixels, up to which the automatic tracking level goes (128 px of 1.8 mm on the
+  /// studies' 230 mm field; docs/tracking.md gives the speed and accuracy measured there).
+  static constexpr int kAutomaticLevelSide_px = 160;
+  /// The options the tracker runs with (the first-frame schedule and the automatic level resolved).
   const CineTrackerOptions& options() const { return m_options; }
   /// Lowercase name of a status ("tracked", "recovered", "lost").
   static const char* statusName(TrackedFrameStatus status);

@@ -19,11 +19,13 @@ struct Tracked {
   fct::RegistrationCase registrationCase;
 };
 
-Tracked prepare(int frames, int viewCount = 2) {
+Tracked prepare(int frames, int viewCount = 2, int size_px = 128, double pixelSpacing_mm = 2.4) {
   fct::Volume ct = fct::test::smallPhantom();
   fct::test::SequenceOptions options;
   options.frames = frames;
   options.viewCount = viewCount;
+  options.size_px = size_px;
+  options.pixelSpacing_mm = pixelSpacing_mm;
   auto sequence = fct::test::simulateSequence(ct, options);
   EXPECT_TRUE(sequence.ok()) << sequence.error();
   auto registrationCase = fct::RegistrationCase::create(ct, sequence.value().views);
@@ -124,6 +126,23 @@ TEST(CineTracker, RejectsBadOptionsAndFrames) {
   auto twoImages = tracker.value().trackNext({t.sequence.frames[1][0], t.sequence.frames[1][0]});
   ASSERT_FALSE(twoImages.ok());
   EXPECT_NE(twoImages.error().find("2 images given for 1 views"), std::string::npos) << twoImages.error();
+}
+
+TEST(CineTracker, AutomaticLevelIsTheFinestAtMost160PixelsAcross) {
+  fct::CineTrackerOptions options;
+  options.firstFrame.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  ASSERT_EQ(options.level, fct::CineTrackerOptions::kAutomaticLevel);
+  Tracked small = prepare(1, 1);  // 128^2: levels of 128, 64 and 32 px
+  auto atSmall = fct::CineTracker::create(small.registrationCase, options);
+  ASSERT_TRUE(atSmall.ok()) << atSmall.error();
+  EXPECT_EQ(atSmall.value().options().level, 0);
+  EXPECT_EQ(atSmall.value().frameSchedule().stages.front().level, 0);
+  Tracked large = prepare(1, 1, 384, 0.8);  // levels of 384, 192 and 96 px
+  auto atLarge = fct::CineTracker::create(large.registrationCase, options);
+  ASSERT_TRUE(atLarge.ok()) << atLarge.error();
+  EXPECT_EQ(atLarge.value().options().level, 2);
+  options.level = -2;
+  EXPECT_FALSE(fct::CineTracker::create(large.registrationCase, options).ok());
 }
 
 TEST(RegistrationCase, ReplaceXrayPreparesTheNewFrameAndKeepsTheViewOnBadInput) {
