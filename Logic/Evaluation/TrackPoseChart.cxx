@@ -15,7 +15,7 @@ ChartSpec TrackPoseChart::spec(const std::vector<TrackedFrame>& frames, const Ei
   static constexpr std::array<const char*, 6> kNames{"rx (deg)", "ry (deg)", "rz (deg)",
                                                      "tx (mm)",  "ty (mm)",  "tz (mm)"};
   ChartSpec chart;
-  chart.title = "Pose change since frame 0 (rotations about the bone centre, translation of the centre)";
+  chart.title = "Pose change since frame 0 (about the bone centre)";
   chart.xLabel = "frame";
   chart.yLabel = "deg / mm";
   chart.width_px = width_px;
