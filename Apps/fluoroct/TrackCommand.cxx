@@ -116,7 +116,7 @@ struct TrackRun {
   std::string drrMethod;
   bool cancelled = false;
   int frameCount = 0;  ///< frames in the sequence
-  int level = 0;       ///< pyramid level the frames after frame 0 were tracked at (the automatic level resolved)
+  CineTrackerOptions tracker;  ///< the settings the tracker ran with (the automatic level resolved)
 
   /// Frames after frame 0 per second of their tracking time (X-ray swap, search, recovery; not reading the files).
   double framesPerSecond() const {
@@ -156,13 +156,13 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                  {{"ct", o.ct},
                                   {"views", o.views},
                                   {"preset", o.preset},
-                                  {"level", run.level},
-                                  {"roi_fraction", o.tracker.roiFraction},
-                                  {"max_evaluations", o.tracker.maxEvaluations},
-                                  {"refine_evaluations", o.tracker.refineEvaluations},
-                                  {"dissimilarity_growth", o.tracker.dissimilarityGrowth},
-                                  {"max_jump_mm", o.tracker.maxJump_mm},
-                                  {"max_jump_deg", o.tracker.maxJump_deg}}}};
+                                  {"level", run.tracker.level},
+                                  {"roi_fraction", run.tracker.roiFraction},
+                                  {"max_evaluations", run.tracker.maxEvaluations},
+                                  {"refine_evaluations", run.tracker.refineEvaluations},
+                                  {"dissimilarity_growth", run.tracker.dissimilarityGrowth},
+                                  {"max_jump_mm", run.tracker.maxJump_mm},
+                                  {"max_jump_deg", run.tracker.maxJump_deg}}}};
 }
 
 std::string trackCsv(const TrackRun& run) {
@@ -238,7 +238,7 @@ void printSummary(const Options& o, const TrackRun& run) {
   fmt::print("{} {} of {} frames: {} tracked, {} recovered, {} lost; {:.2f} frames/s after frame 0 at pyramid level {} "
              "(frame 0: {:.2f} s)",
              run.cancelled ? "cancelled after" : "tracked", run.frames.size(), run.frameCount, counts[0], counts[1],
-             counts[2], run.framesPerSecond(), run.level, run.frames.empty() ? 0.0 : run.frames.front().seconds);
+             counts[2], run.framesPerSecond(), run.tracker.level, run.frames.empty() ? 0.0 : run.frames.front().seconds);
   if (!cpu.empty()) fmt::print("; per-frame CPU median {:.3f} s, max {:.3f} s", cpu[cpu.size() / 2], cpu.back());
   fmt::print("; wrote {}\n", (fs::path(o.out) / "track.json").string());
 }
@@ -274,7 +274,7 @@ int runTrack(const Options& o) {
   run.centre_ct_mm = registrationCase.value().rotationCentre_ct_mm();
   run.drrMethod = std::string(DrrRendererFactory::methodName(method.value()));
   run.frameCount = in.frameCount;
-  run.level = tracker.value().options().level;
+  run.tracker = tracker.value().options();
   auto first = tracker.value().trackFirst(in.initial.T_world_from_ct, cancel);
   if (!first) return reportError(first.error());
   run.frames.push_back(first.value());

@@ -42,7 +42,7 @@ std::vector<std::uint8_t> sliceFootprint(const DrrVolume& volume, int k, const E
 int nearest(double x) { return static_cast<int>(std::floor(x + 0.5)); }
 
 /// Narrows [qFirst, qLast] (sample indices; sample q at t0 + step·q) to the samples whose coordinate a + d·t along
-/// one axis lies in [low, high].
+/// one axis lies in [low, high]; the result stays inside the given range (empty: qLast < qFirst).
 void narrowToSlab(double a, double d, double t0, double step, double low, double high, int& qFirst, int& qLast) {
   const double slope = d * step;  // coordinate change per sample
   const double start = a + d * t0;
@@ -97,8 +97,6 @@ bool CutFaceRayMask::crosses(const Face& face, const Eigen::Vector3d& a, const E
   int qFirst = 0, qLast = samples - 1;
   narrowToSlab(a.x(), d.x(), t0, step, face.iMin - 1.0, face.iMax + 1.0, qFirst, qLast);
   narrowToSlab(a.y(), d.y(), t0, step, face.jMin - 1.0, face.jMax + 1.0, qFirst, qLast);
-  qFirst = std::max(qFirst, 0);
-  qLast = std::min(qLast, samples - 1);
   for (int q = qFirst; q <= qLast; ++q) {
     const Eigen::Vector3d p = a + d * (t0 + (t1 - t0) * q / (samples - 1));
     const int i = std::clamp(nearest(p.x()), 0, ni - 1);

@@ -3,6 +3,8 @@
 #include <opencv2/imgproc.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -29,7 +31,9 @@ cv::Mat discErosion(const cv::Mat& image, int side, float outside) {
   const int widest = std::max(0, *std::max_element(halfWidth.begin(), halfWidth.end()));
   const auto stride = static_cast<std::size_t>(cols);
   cv::Mat out(rows, cols, CV_32F, cv::Scalar(outside));
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 64), [&](const tbb::blocked_range<int>& band) {
+  // One band of rows per thread: a band recomputes the chords of the `radius` rows above and below it.
+  const int bandRows = std::max(1, (rows + tbb::this_task_arena::max_concurrency() - 1) / tbb::this_task_arena::max_concurrency());
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, bandRows), [&](const tbb::blocked_range<int>& band) {
     std::vector<float> padded(stride + 2 * static_cast<std::size_t>(widest), outside);
     std::vector<float> chords(stride * (static_cast<std::size_t>(widest) + 1));  // chords[w * cols + x]
     const int first = std::max(0, band.begin() - radius), last = std::min(rows, band.end() + radius);
@@ -52,7 +56,7 @@ cv::Mat discErosion(const cv::Mat& image, int side, float outside) {
         for (int x = 0; x < cols; ++x) target[x] = std::min(target[x], chord[x]);
       }
     }
-  });
+  }, tbb::simple_partitioner());
   return out;
 }
 
