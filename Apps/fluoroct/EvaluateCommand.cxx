@@ -431,7 +431,7 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
                       "CT volume(s) or DICOM folder(s) instead of the defaults (full: the pelvis of $FLUOROCT_DATA_DIR, "
                       "plus its head phantom for table2; quick: the phantom)");
   command->add_option("--preset", options->preset,
-                      "Registration preset: clinical, paper, fast or a preset FILE.json (default: clinical, the product default; --quick: fast)");
+                      "Registration preset: clinical, accurate, paper, fast or a preset FILE.json (default: clinical, the product default; --quick: fast)");
   command->add_option("--detector", options->detector,
                       "Detector size in pixels, COLSxROWS (default 800x600; --quick 128x128); the field is COLS x "
                       "--pixel-mm wide, as in `fluoroct views`");

@@ -167,21 +167,42 @@ Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level, const Ei
 }
 
 Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int level,
-                                                           const Eigen::Isometry3d& T_world_from_ct, int pixelStride) {
+                                                           const Eigen::Isometry3d& T_world_from_ct, int pixelStride,
+                                                           std::optional<DrrMethod> method, double rayCastStep_voxels) {
   if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
   const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct, std::max(1, pixelStride));
-  if ((block.array() == 1).all()) return m_renderer.get();
-  const std::array<int, 3> key{block.x(), block.y(), block.z()};
-  auto found = m_coarseRenderers.find(key);
-  if (found == m_coarseRenderers.end()) {
+  const DrrMethod exactMethod = method.value_or(exactRendererOptions(m_drrOptions).method);
+  if ((block.array() == 1).all()) return methodRenderer(exactMethod, rayCastStep_voxels);
+  if (exactMethod == DrrMethod::Transgraph) return fail("a coarsened CT is rendered with siddon or raycast, not transgraph");
+  return keptRenderer(exactMethod, block, rayCastStep_voxels);
+}
+
+Result<const DrrRenderer*> RegistrationCase::methodRenderer(DrrMethod method, double rayCastStep_voxels) {
+  if (method == exactRendererOptions(m_drrOptions).method && rayCastStep_voxels == 0.0) return m_renderer.get();
+  if (method == DrrMethod::Transgraph) return fail("the transgraph is built per view, not as a CT renderer");
+  return keptRenderer(method, Eigen::Vector3i::Ones(), rayCastStep_voxels);
+}
+
+Result<const DrrRenderer*> RegistrationCase::keptRenderer(DrrMethod method, const Eigen::Vector3i& block,
+                                                          double rayCastStep_voxels) {
+  if (!(rayCastStep_voxels >= 0.0 && rayCastStep_voxels <= 10.0)) {  // also NaN
+    return fail(fmt::format("ray-cast step must be 0 (the default) to 10 voxels, got {}", rayCastStep_voxels));
+  }
+  const RendererKey key{method, {block.x(), block.y(), block.z()}, rayCastStep_voxels};
+  auto found = m_keptRenderers.find(key);
+  if (found != m_keptRenderers.end()) return found->second.get();
+  std::shared_ptr<const DrrVolume> volume = m_drrVolume;
+  if ((block.array() != 1).any()) {
     auto coarse = m_drrVolume->coarsened(block);
     if (!coarse) return fail(coarse.error());
-    auto renderer = DrrRendererFactory::create(std::make_shared<const DrrVolume>(std::move(coarse).value()),
-                                               exactRendererOptions(m_drrOptions));
-    if (!renderer) return fail(renderer.error());
-    found = m_coarseRenderers.emplace(key, std::move(renderer).value()).first;
+    volume = std::make_shared<const DrrVolume>(std::move(coarse).value());
   }
-  return found->second.get();
+  DrrRendererOptions options = m_drrOptions;
+  options.method = method;
+  if (rayCastStep_voxels > 0.0) options.rayCastStep_mm = rayCastStep_voxels * std::cbrt(volume->values().spacing_mm().prod());
+  auto renderer = DrrRendererFactory::create(volume, options);
+  if (!renderer) return fail(renderer.error());
+  return m_keptRenderers.emplace(key, std::move(renderer).value()).first->second.get();
 }
 
 Status RegistrationCase::checkViewLevel(std::size_t v, int level) const {

@@ -26,6 +26,8 @@ constexpr NameTable<SearchStrategy, 3> kSearches{
     {{"genetic", SearchStrategy::Genetic}, {"cmaes", SearchStrategy::CmaEs}, {"local", SearchStrategy::Local}}};
 constexpr NameTable<LocalSearchMethod, 2> kLocalMethods{
     {{"simplex", LocalSearchMethod::Simplex}, {"bobyqa", LocalSearchMethod::Bobyqa}}};
+/// The exact methods a stage may name in "drr" (the Transgraph is built per view and case, not per stage).
+constexpr NameTable<DrrMethod, 2> kStageDrrMethods{{{"siddon", DrrMethod::Siddon}, {"raycast", DrrMethod::RayCast}}};
 constexpr NameTable<PixelSetKind, 2> kPixelSets{
     {{"whole", PixelSetKind::WholeImage}, {"rois", PixelSetKind::Rois}}};
 
@@ -71,6 +73,15 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
       stage.exactDrr = exact->get<bool>();
     } else {
       reader.rejectKey("exact_drr", fmt::format("is {}; use true or false", JsonReader::describe(*exact)));
+    }
+  }
+  if (reader.has("drr")) stage.drrMethod = parseName(reader, "drr", kStageDrrMethods);
+  optionalNumber(reader, "drr_step_voxels", stage.drrStep_voxels);
+  if (reader.ok() && reader.has("drr_step_voxels")) {
+    if (stage.drrMethod != DrrMethod::RayCast) {
+      reader.rejectKey("drr_step_voxels", "applies only with \"drr\": \"raycast\"");
+    } else if (!(stage.drrStep_voxels > 0.0 && stage.drrStep_voxels <= 10.0)) {
+      reader.rejectKey("drr_step_voxels", fmt::format("is {}; use a step above 0 and at most 10 voxels", stage.drrStep_voxels));
     }
   }
 
@@ -236,12 +247,15 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
                        {"population", s.cmaes.populationSize},
                        {"max_evaluations", s.cmaes.maxEvaluations},
                        {"seed", s.cmaes.seed}};
-    stagesJson.push_back({{"name", s.name},
-                          {"metric", metricName(s.metric)},
-                          {"level", s.level},
-                          {"exact_drr", s.exactDrr},
-                          {"pixels", std::move(pixels)},
-                          {"search", std::move(search)}});
+    nlohmann::ordered_json stageJson{{"name", s.name},
+                                     {"metric", metricName(s.metric)},
+                                     {"level", s.level},
+                                     {"exact_drr", s.exactDrr}};
+    if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
+    if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
+    stageJson["pixels"] = std::move(pixels);
+    stageJson["search"] = std::move(search);
+    stagesJson.push_back(std::move(stageJson));
   }
   return nlohmann::ordered_json{{"name", name}, {"description", description}, {"stages", std::move(stagesJson)}};
 }

@@ -9,11 +9,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "Base/Result.h"
+#include "Drr/DrrRendererFactory.h"
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
 #include "Search/LocalPoseOptimizer.h"
@@ -49,6 +51,13 @@ struct RegistrationStage {
   /// Render with the case's exact renderer even when it has per-view Transgraphs (whose interpolation smooths detail
   /// finer than the table spacing: measured too coarse for the full-resolution stage, see README).
   bool exactDrr = false;
+  /// Render this stage exactly with this method ("siddon" or "raycast") whatever the case's method (the Transgraph is
+  /// then not used either); nullopt: the case's renderers. Trilinear sampling ("raycast") models a smooth patient where
+  /// exact box voxels show the CT's staircase (docs/evaluation.md, "Start at the truth").
+  std::optional<DrrMethod> drrMethod;
+  /// With drrMethod raycast: the sampling step in voxels (one voxel: the cube root of the voxel volume); 0: the
+  /// renderer's default, half the smallest spacing.
+  double drrStep_voxels = 0.0;
   PixelSetSpec pixels;
   SearchStrategy search = SearchStrategy::Local;
   int maxEvaluations = 1000;       ///< cap on DRR sets (one per view) of the stage's search

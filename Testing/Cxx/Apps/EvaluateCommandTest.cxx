@@ -109,7 +109,7 @@ TEST(EvaluateCommand, QuickTable2WritesTrialsChartsAndTheTableBesideThePaper) {
   EXPECT_NE(report.find("| phantom | ideal | 2 mm (original) | 2 |"), std::string::npos) << report;
   EXPECT_NE(report.find("DRR method `siddon`; detector 128x128 px at 2.4 mm"), std::string::npos) << report;
   EXPECT_NE(fct::test::readText(out / "setup.txt").find("detector: 128x128\npixel_mm: 2.4\n"), std::string::npos);
-  EXPECT_NE(report.find("paper mean sTRE"), std::string::npos);
+  EXPECT_NE(report.find("paper: mean (max) sTRE"), std::string::npos);
   EXPECT_NE(report.find("![Success rate by scenario](table2_success.png)"), std::string::npos);
 }
 

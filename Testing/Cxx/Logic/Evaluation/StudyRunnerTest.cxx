@@ -128,10 +128,14 @@ TEST(StudyXraySource, RegistrationCtIsTheOriginalUnlessTheScenarioAsksForCoarser
 TEST(StudyRunner, NotesSayWhenAScenarioKeepsTheOriginalCt) {
   const auto study = fct::StudyCatalog::define("table2", false, {"pelvis"}).value();
   const std::vector<std::string> notes = fct::StudyRunner::notes(study, {{"pelvis", tinyCt(3.0)}});
-  ASSERT_EQ(notes.size(), 3u);  // X-ray model, DRR method, 'realistic' (2.4 mm < 3 mm); 'bad' (4.2 mm) is resampled
+  // X-ray model, DRR method, the default preset's trilinear final stage, 'realistic' (2.4 mm < 3 mm); 'bad' (4.2 mm)
+  // is resampled.
+  ASSERT_EQ(notes.size(), 4u);
   EXPECT_EQ(notes[0].rfind("X-rays: FluoroscopySimulator", 0), 0u);
   EXPECT_EQ(notes[1], "DRRs: siddon method");
-  EXPECT_NE(notes[2].find("scenario 'realistic'"), std::string::npos) << notes[2];
+  EXPECT_EQ(notes[2], "the preset's stage 'vlnc-rois-1:1' renders its DRRs with the raycast method (a sample every 1 "
+                      "voxel), whatever the study's");
+  EXPECT_NE(notes[3].find("scenario 'realistic'"), std::string::npos) << notes[3];
 }
 
 TEST(StudyRunner, ResolveSliceSpacingsGivesTheSpacingActuallyUsed) {

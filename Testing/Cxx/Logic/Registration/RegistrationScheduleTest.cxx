@@ -27,7 +27,7 @@ TEST(RegistrationSchedule, PaperPresetHasThePapersThreeStages) {
   EXPECT_EQ(s[2].level, 0);
   EXPECT_EQ(s[2].pixels.kind, fct::PixelSetKind::Rois);
   EXPECT_EQ(s[2].search, fct::SearchStrategy::Local);
-  EXPECT_EQ(RegistrationSchedule::builtinNames(), (std::vector<std::string>{"clinical", "fast", "paper"}));
+  EXPECT_EQ(RegistrationSchedule::builtinNames(), (std::vector<std::string>{"accurate", "clinical", "fast", "paper"}));
 }
 
 TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) {
@@ -43,6 +43,9 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
     EXPECT_EQ(s[i].pixels.kind, fct::PixelSetKind::Rois);
   }
   EXPECT_EQ(s.back().level, 0) << "ends at full resolution";
+  EXPECT_EQ(s.back().drrMethod, fct::DrrMethod::RayCast) << "on trilinear DRRs (a smooth patient)";
+  EXPECT_EQ(s.back().drrStep_voxels, 1.0);
+  for (std::size_t i = 0; i + 1 < s.size(); ++i) EXPECT_FALSE(s[i].drrMethod) << "the others on the case's renderers";
   int budget = 0;
   for (const auto& stage : s) budget += stage.maxEvaluations;
   EXPECT_LE(3 * budget, 4500) << "about the paper's 3,000 DRRs for 3 views, not 8,500";
@@ -102,6 +105,13 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "all"}, )" + search + "]}", "set"},
       {stageHead + R"("metric": "ncc", "level": 0, "exact_drr": "yes", "pixels": {"set": "whole"}, )" + search + "]}",
        "exact_drr"},
+      {stageHead + R"("metric": "ncc", "level": 0, "drr": "transgraph", "pixels": {"set": "whole"}, )" + search + "]}",
+       "drr"},
+      {stageHead + R"("metric": "ncc", "level": 0, "drr_step_voxels": 1, "pixels": {"set": "whole"}, )" + search + "]}",
+       "drr_step_voxels"},
+      {stageHead + R"("metric": "ncc", "level": 0, "drr": "raycast", "drr_step_voxels": 0, "pixels": {"set": "whole"}, )" +
+           search + "]}",
+       "drr_step_voxels"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}})" + "]}", "search"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "local", )" +
            R"("max_evaluations": 10, "simplex": {"tolerance": -1}}}]})",

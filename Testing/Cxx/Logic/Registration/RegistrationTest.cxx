@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <numeric>
 #include <string>
 
+#include "Drr/TrilinearRayCaster.h"
 #include "IO/Volume/VolumeFileIO.h"
 #include "Registration/Registration.h"
 #include "Registration/RegistrationObjective.h"
@@ -355,6 +357,40 @@ TEST(Registration, CtPyramidCoarsensTheCtOnlyWherePixelsSpanSeveralVoxels) {
   const double fullSum = std::accumulate(full.pixels.begin(), full.pixels.end(), 0.0);
   const double blurredSum = std::accumulate(blurred.pixels.begin(), blurred.pixels.end(), 0.0);
   EXPECT_NEAR(blurredSum / fullSum, 1.0, 0.02) << "the total attenuation seen is kept";
+}
+
+TEST(Registration, AStageNamingItsDrrMethodRendersWithItAtItsStep) {
+  Prepared p = preparePhantom();  // Siddon case, 2 mm voxels
+  fct::RegistrationCase& rc = p.registrationCase;
+  const Eigen::Isometry3d& T = p.simulated.T_truth;
+  EXPECT_EQ(rc.methodRenderer(fct::DrrMethod::Siddon).value(), &rc.renderer());
+  const fct::DrrRenderer* oneVoxel = rc.methodRenderer(fct::DrrMethod::RayCast, 1.0).value();
+  ASSERT_EQ(oneVoxel->methodName(), "raycast");
+  EXPECT_EQ(dynamic_cast<const fct::TrilinearRayCaster&>(*oneVoxel).step_mm(), 2.0);
+  EXPECT_EQ(rc.methodRenderer(fct::DrrMethod::RayCast, 1.0).value(), oneVoxel) << "made once, then kept";
+  const fct::DrrRenderer* caseStep = rc.methodRenderer(fct::DrrMethod::RayCast).value();
+  EXPECT_EQ(dynamic_cast<const fct::TrilinearRayCaster&>(*caseStep).step_mm(), 1.0) << "half the smallest spacing";
+  // At level 2 the CT is coarsened to 4 mm voxels; the step in voxels follows them.
+  const fct::DrrRenderer* coarse = rc.levelRenderer(0, 2, T, 1, fct::DrrMethod::RayCast, 1.0).value();
+  EXPECT_EQ(coarse->volume().values().spacing_mm(), Eigen::Vector3d(4.0, 4.0, 4.0));
+  EXPECT_EQ(dynamic_cast<const fct::TrilinearRayCaster&>(*coarse).step_mm(), 4.0);
+  for (const double badStep : {-1.0, 11.0, std::nan("")}) {
+    auto bad = rc.methodRenderer(fct::DrrMethod::RayCast, badStep);
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().find("step"), std::string::npos) << bad.error();
+  }
+  EXPECT_FALSE(rc.methodRenderer(fct::DrrMethod::Transgraph).ok());
+
+  // The objective of such a stage renders every view with it, and still sees the match at the truth.
+  fct::RegistrationStage stage = fastOptions().schedule.stages.back();
+  stage.drrMethod = fct::DrrMethod::RayCast;
+  stage.drrStep_voxels = 1.0;
+  auto objective = fct::RegistrationObjective::create(rc, stage, true, T);
+  ASSERT_TRUE(objective.ok()) << objective.error();
+  EXPECT_EQ(objective.value().drrMethodName(), "raycast");
+  Eigen::Isometry3d off = T;
+  off.translation() += Eigen::Vector3d(3.0, 0.0, 0.0);
+  EXPECT_GT(objective.value().similarity(T).value(), objective.value().similarity(off).value());
 }
 
 TEST(Registration, WithoutTheCtPyramidTheSameStartConvergesAsWell) {
