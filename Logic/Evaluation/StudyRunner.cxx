@@ -423,12 +423,8 @@ std::vector<std::string> StudyRunner::notes(const StudyDefinition& study, const 
     out.push_back(fmt::format("DRRs: {} method", DrrRendererFactory::methodName(study.setup.method)));
   }
   if (auto schedule = RegistrationSchedule::resolve(study.setup.preset)) {
-    for (const RegistrationStage& stage : schedule.value().stages) {
-      if (!stage.drrMethod) continue;
-      const std::string step =
-          stage.drrStep_voxels > 0.0 ? fmt::format(" (a sample every {:g} voxel)", stage.drrStep_voxels) : std::string();
-      out.push_back(fmt::format("the preset's stage '{}' renders its DRRs with the {} method{}, whatever the study's",
-                                stage.name, DrrRendererFactory::methodName(*stage.drrMethod), step));
+    for (const std::string& note : schedule.value().stageDrrNotes()) {
+      out.push_back("the preset's " + note + ", whatever the study's");
     }
   }
   std::set<std::string> said;

@@ -258,6 +258,9 @@ std::vector<std::string> TrackingStudy::notes(const TrackingStudyDefinition& stu
                             "recovery when lost); registration on the original CT, Siddon DRRs",
                             study.preset, study.initialStre_mm, 100.0 * CineTrackerOptions{}.roiFraction,
                             CineTracker::kAutomaticLevelSide_px));
+  if (auto schedule = RegistrationSchedule::resolve(study.preset)) {
+    for (const std::string& note : schedule.value().stageDrrNotes()) out.push_back("frame 0: the preset's " + note);
+  }
   return out;
 }
 

@@ -107,14 +107,9 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
     const PyramidLevel& pyramidLevel = registrationCase.prepared(v).pyramid.level(level);
     View view;
-    // A stage that names its DRR method renders exactly with it (not the case's tables or renderer).
+    // A stage that names its DRR method renders exactly with it (not the case's tables or renderer; set below).
     const bool viewRenderers = useViewRenderers && !stage.drrMethod;
     view.renderer = viewRenderers ? &registrationCase.renderer(v) : &registrationCase.renderer();
-    if (stage.drrMethod) {
-      auto renderer = registrationCase.methodRenderer(*stage.drrMethod, stage.drrStep_voxels);
-      if (!renderer) return fail(fmt::format("{}: {}", where(v), renderer.error()));
-      view.renderer = renderer.value();
-    }
     const bool tableRenderer = viewRenderers && registrationCase.transgraph(v) != nullptr;
     view.camera = registrationCase.camera(v);
     std::optional<ValidMask> cutFaces;
@@ -174,11 +169,14 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
     // (fewer, larger voxels per ray), as the level's own pixels are. (GC renders the whole level: no coarsening.)
     if (!tableRenderer && T_coarseCt_world_from_ct) {
       const int footprintStride = stage.metric == SimilarityMetric::Ncc ? stride : 1;
-      auto levelRenderer =
-          registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct, footprintStride,
+      auto levelRenderer = registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct, footprintStride,
                                                           stage.drrMethod, stage.drrStep_voxels);
       if (!levelRenderer) return fail(fmt::format("{}: {}", where(v), levelRenderer.error()));
       view.renderer = levelRenderer.value();
+    } else if (stage.drrMethod) {
+      auto methodRenderer = registrationCase.methodRenderer(*stage.drrMethod, stage.drrStep_voxels);
+      if (!methodRenderer) return fail(fmt::format("{}: {}", where(v), methodRenderer.error()));
+      view.renderer = methodRenderer.value();
     }
     view.keptFraction = validCount ? static_cast<double>(view.pixels.size()) / static_cast<double>(validCount) : 0.0;
 

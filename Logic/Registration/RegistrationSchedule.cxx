@@ -260,6 +260,18 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
   return nlohmann::ordered_json{{"name", name}, {"description", description}, {"stages", std::move(stagesJson)}};
 }
 
+std::vector<std::string> RegistrationSchedule::stageDrrNotes() const {
+  std::vector<std::string> out;
+  for (const RegistrationStage& s : stages) {
+    if (!s.drrMethod) continue;
+    const std::string step =
+        s.drrStep_voxels > 0.0 ? fmt::format(" (a sample every {:g} voxel)", s.drrStep_voxels) : std::string();
+    out.push_back(fmt::format("stage '{}' renders its DRRs with the {} method{}", s.name,
+                              nameOf(*s.drrMethod, kStageDrrMethods), step));
+  }
+  return out;
+}
+
 RegistrationSchedule RegistrationSchedule::withAblation(const RegistrationAblation& ablation) const {
   RegistrationSchedule result = *this;
   const auto active = ablation.activeNames();

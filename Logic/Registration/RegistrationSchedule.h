@@ -101,6 +101,9 @@ class RegistrationSchedule {
 
   /// The schedule in the JSON schema fromJson() reads (a round trip gives an equal schedule).
   nlohmann::ordered_json toJson() const;
+  /// One line per stage that names its own DRR method, for reports: "stage 'S' renders its DRRs with the raycast
+  /// method (a sample every 1 voxel)". Empty when every stage uses the case's renderers.
+  std::vector<std::string> stageDrrNotes() const;
   /// This schedule with the given techniques switched off (see RegistrationAblation); the name gets a suffix.
   RegistrationSchedule withAblation(const RegistrationAblation& ablation) const;
   /// This schedule with every stage's random seed derived from `seed` (stage i gets seed + i).

@@ -46,6 +46,9 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
   EXPECT_EQ(s.back().drrMethod, fct::DrrMethod::RayCast) << "on trilinear DRRs (a smooth patient)";
   EXPECT_EQ(s.back().drrStep_voxels, 1.0);
   for (std::size_t i = 0; i + 1 < s.size(); ++i) EXPECT_FALSE(s[i].drrMethod) << "the others on the case's renderers";
+  EXPECT_EQ(preset.value().stageDrrNotes(),
+            std::vector<std::string>{"stage 'vlnc-rois-1:1' renders its DRRs with the raycast method (a sample every 1 voxel)"});
+  EXPECT_TRUE(RegistrationSchedule::builtin("paper").value().stageDrrNotes().empty());
   int budget = 0;
   for (const auto& stage : s) budget += stage.maxEvaluations;
   EXPECT_LE(3 * budget, 4500) << "about the paper's 3,000 DRRs for 3 views, not 8,500";
