@@ -50,6 +50,7 @@ struct EvaluateOptions {
   std::string detector;  ///< COLSxROWS; empty: the study's
   double pixel_mm = 0.0; ///< > 0: detector pixel size
   std::string method = "siddon";
+  bool oneXraySet = false;  ///< every trial of a CT registers against one X-ray set (StudySetup::xraysPerTrial off)
   std::string shard;               ///< K/N: run only shard K of N; empty: every trial
   std::vector<std::string> merge;  ///< shard output folders to merge into --out instead of running trials
 };
@@ -78,6 +79,7 @@ Result<StudyDefinition> defineStudy(const EvaluateOptions& o, const std::vector<
   }
   if (o.pixel_mm > 0.0) setup.detector.pixelSpacing_mm = o.pixel_mm;
   if (method.value() == DrrMethod::Transgraph) setup.transgraphCacheDir = transgraphCacheDir(o.out);
+  setup.xraysPerTrial = !o.oneXraySet;
   return study;
 }
 
@@ -238,8 +240,8 @@ std::vector<std::string> reportNotes(const EvaluateOptions& o, const PreparedStu
                                             p.shard->text(), p.shard->count()));
   }
   notes.insert(notes.begin(),
-               fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}{}{}{}{} --method {}`; setup (compared on "
-                           "resume, DIR/setup.txt): {}",
+               fmt::format("command: `fluoroct evaluate --study {}{} --out {}{}{}{}{}{}{} --method {}{}`; setup (compared "
+                           "on resume, DIR/setup.txt): {}",
                            o.study, o.quick ? " --quick" : "", o.out,
                            p.shard ? " --shard " + p.shard->text() : "",
                            o.trials > 0 ? fmt::format(" --trials {}", o.trials) : "",
@@ -247,7 +249,7 @@ std::vector<std::string> reportNotes(const EvaluateOptions& o, const PreparedStu
                            o.preset.empty() ? "" : " --preset " + o.preset,
                            o.detector.empty() ? "" : " --detector " + o.detector,
                            o.pixel_mm > 0 ? fmt::format(" --pixel-mm {:g}", o.pixel_mm) : "", o.method,
-                           oneLine(p.setup)));
+                           o.oneXraySet ? " --one-xray-set" : "", oneLine(p.setup)));
   return notes;
 }
 
@@ -291,9 +293,10 @@ std::string trackingSetupText(const EvaluateOptions& o, const TrackingStudyDefin
 /// DIR/frames.csv, then writes DIR/report.md and DIR/summary.csv (TrackingReport).
 int runTrackingStudy(const EvaluateOptions& o) {
   if (!o.shard.empty() || !o.merge.empty() || !o.detector.empty() || o.pixel_mm != 0.0 || o.method != "siddon" ||
-      o.jobs != 1) {
-    return reportError("the tracking study fixes its detectors and runs its sequences one after another: drop "
-                       "--shard, --merge, --detector, --pixel-mm, --method and --jobs");
+      o.jobs != 1 || o.oneXraySet) {
+    return reportError("the tracking study fixes its detectors, runs its sequences one after another and simulates "
+                       "every frame: drop --shard, --merge, --detector, --pixel-mm, --method, --jobs and "
+                       "--one-xray-set");
   }
   if (o.trials < 0) return reportError(fmt::format("--trials must be positive, got {}", o.trials));
   auto checked = TrackingStudy::define(o.quick, {"ct"});
@@ -440,6 +443,9 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
                       "DRR method: siddon (exact) or transgraph (tables built around each trial's start pose, cached "
                       "in OUT/transgraph-cache)")
       ->capture_default_str();
+  command->add_flag("--one-xray-set", options->oneXraySet,
+                    "Register every trial of a CT against one X-ray set at the study's true pose, instead of each "
+                    "trial against its own (bone pose, foreign objects and noise drawn from the trial's seed)");
   CLI::Option* shard = command->add_option(
       "--shard", options->shard,
       "Run only shard K of N, as K/N (e.g. 2/8), into its own --out; the trials are dealt round robin, so every shard "

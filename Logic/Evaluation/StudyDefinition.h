@@ -29,7 +29,8 @@ enum class StudyStart {
   SupineSetup,      ///< the clinical setup alone, no landmarks: supine at the C-arm isocentre (SetupPose)
 };
 
-/// One compared condition of a study; its trials differ only by the random start pose and search seed.
+/// One compared condition of a study; its trials differ by the random start pose and search seed and, with
+/// StudySetup::xraysPerTrial, by their own simulated X-rays.
 struct StudyCondition {
   std::string name;               ///< unique within the study, e.g. "pelvis/realistic" (the resume key with the trial)
   std::string ct;                 ///< label of the CT (StudyCt::label)
@@ -55,6 +56,10 @@ struct StudySetup {
   std::string preset = RegistrationSchedule::kDefaultPreset;  ///< registration schedule (RegistrationSchedule::resolve)
   StandardViewOptions detector;   ///< C-arm geometry and detector (its count is ignored: conditions choose)
   std::uint32_t seed = 1;         ///< base seed: trial t of every condition starts from seed + t
+  /// True: every trial registers against X-rays of its own (StudyRunner::trialTruthPose: the bone placed around the
+  /// study's true pose; its own foreign-object placement and noise), all from its seed, so a condition's mean is over
+  /// X-ray realizations and not one image set's optimum. False: every trial of a CT uses one X-ray set at the true pose.
+  bool xraysPerTrial = true;
   DrrMethod method = DrrMethod::Siddon;  ///< DRR method of the registrations (a condition's ablation may switch the
                                          ///< Transgraph off)
   double transgraphSpacing_mm = 3.0;     ///< Transgraph table step (TransgraphParameters::spacing_mm)

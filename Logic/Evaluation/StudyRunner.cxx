@@ -32,12 +32,14 @@ namespace {
 
 constexpr int kMaxViews = 5;
 
-/// Everything about one CT that its trials share: error measures, truth and the simulated X-rays (all views), without
-/// and (when a scenario needs them) with foreign objects.
+/// Everything about one CT that its trials share: error measures, truth, the views and the X-rays simulated at the
+/// truth (all views), without and (when a scenario needs them) with foreign objects. The cases are prepared on those
+/// X-rays; with per-trial X-rays each trial then swaps in its own.
 struct CtScene {
   const Volume* ct = nullptr;
   std::unique_ptr<PoseErrorMetrics> metrics;
   Eigen::Isometry3d T_truth = Eigen::Isometry3d::Identity();
+  std::vector<ViewSpec> views;
   std::vector<RegistrationView> xrays;
   std::vector<RegistrationView> xraysWithObjects;
 };
@@ -130,19 +132,42 @@ TrialRecord failedTrial(const StudyDefinition& study, const StudyCondition& c, i
   return r;
 }
 
+/// The trial's true pose, and with per-trial X-rays its own X-rays swapped into `registrationCase`. Fails naming the
+/// simulation or the view whose X-ray the case rejects.
+Result<Eigen::Isometry3d> prepareTrialXrays(const StudyDefinition& study, const StudyCondition& c, std::uint32_t seed,
+                                            const CtScene& scene, RegistrationCase& registrationCase) {
+  if (!study.setup.xraysPerTrial) return scene.T_truth;
+  const Eigen::Isometry3d T_truth = StudyRunner::trialTruthPose(scene.metrics->surface(), seed);
+  const std::vector<ViewSpec> views(scene.views.begin(), scene.views.begin() + c.viewCount);
+  auto xrays = StudyXraySource::simulate(*scene.ct, views, T_truth, StudyRunner::trialXraySeed(seed),
+                                         StudyCatalog::scenarioHasForeignObjects(c.scenario));
+  if (!xrays) return fail("simulating the trial's X-rays: " + xrays.error());
+  for (std::size_t v = 0; v < xrays.value().size(); ++v) {
+    if (Status swapped = registrationCase.replaceXray(v, xrays.value()[v].xray); !swapped) return fail(swapped.error());
+  }
+  return T_truth;
+}
+
 /// Runs one trial on `registrationCase` (a worker's own copy).
 TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int trial, const CtScene& scene,
                      RegistrationCase& registrationCase, const RegistrationSchedule& schedule,
                      const std::atomic<bool>* cancel) {
   TrialRecord r = failedTrial(study, c, trial, "");
+  auto truth = prepareTrialXrays(study, c, r.seed, scene, registrationCase);
+  if (!truth) {
+    r.reason = truth.error();
+    return r;
+  }
+  const Eigen::Isometry3d& T_truth = truth.value();
+  r.truthOffset_mm = scene.metrics->measure(T_truth, scene.T_truth).streMean_mm;
 
-  auto start = StudyRunner::startPose(c, scene.metrics->surface(), scene.T_truth, cameras(scene.xrays), r.seed,
+  auto start = StudyRunner::startPose(c, scene.metrics->surface(), T_truth, cameras(scene.xrays), r.seed,
                                       r.initialTarget_mm);
   if (!start) {
     r.reason = "start pose: " + start.error();
     return r;
   }
-  r.initialStre_mm = scene.metrics->measure(start.value(), scene.T_truth).streMean_mm;
+  r.initialStre_mm = scene.metrics->measure(start.value(), T_truth).streMean_mm;
 
   RegistrationOptions options;
   options.schedule = schedule;
@@ -159,7 +184,7 @@ TrialRecord runTrial(const StudyDefinition& study, const StudyCondition& c, int 
   r.seconds -= r.setupSeconds;
   r.status = TrialStatus::Ok;
   r.drrs = result.value().totalDrrs;
-  r.error = scene.metrics->measure(result.value().T_world_from_ct, scene.T_truth);
+  r.error = scene.metrics->measure(result.value().T_world_from_ct, T_truth);
   r.success = PoseErrorMetrics::isSuccess(r.error);
   if (result.value().cancelled) {
     r.status = TrialStatus::Cancelled;
@@ -217,6 +242,7 @@ Result<CtScene> simulateScene(const StudyCt& ct, int viewCount, bool withObjects
   viewOptions.count = viewCount;
   auto views = StandardViews::build(Eigen::Vector3d::Zero(), viewOptions);
   if (!views) return fail(views.error());
+  scene.views = views.value();
   say(options, fmt::format("simulating {} X-ray views of CT '{}'", viewCount, ct.label));
   auto xrays = StudyXraySource::simulate(ct.volume, views.value(), scene.T_truth, setup.seed, false);
   if (!xrays) return fail(fmt::format("CT '{}': {}", ct.label, xrays.error()));
@@ -393,6 +419,19 @@ Result<Eigen::Isometry3d> StudyRunner::startPose(const StudyCondition& c, const 
   return fail("unknown start kind");
 }
 
+Eigen::Isometry3d StudyRunner::trialTruthPose(const BoneSurface& bone, std::uint32_t seed) {
+  SeededRandom random(SeededRandom::streamSeed(seed, 0x7455u));
+  PoseParameters move;
+  for (int a = 0; a < 3; ++a) move.rotation_deg[a] = random.uniform(-kTrialSpread_deg, kTrialSpread_deg);
+  for (int a = 0; a < 3; ++a) move.translation_mm[a] = random.uniform(-kTrialSpread_mm, kTrialSpread_mm);
+  const Eigen::Isometry3d T_truth = truthPose(bone);
+  // The move about the bone centre in the world: M(p) = R (p - c_world) + c_world + t.
+  const Eigen::Vector3d centre_world_mm = T_truth * bone.centroid_ct_mm();
+  return Eigen::Isometry3d(RigidPose::toTransform(move, centre_world_mm) * T_truth);
+}
+
+std::uint32_t StudyRunner::trialXraySeed(std::uint32_t seed) { return SeededRandom::streamSeed(seed, 0x58524159u); }
+
 Eigen::Isometry3d StudyRunner::truthPose(const BoneSurface& bone) {
   const Eigen::Vector3d centre_ct_mm = bone.centroid_ct_mm();
   PoseParameters truth;
@@ -412,6 +451,14 @@ void StudyRunner::resolveSliceSpacings(StudyDefinition& study, const std::vector
 
 std::vector<std::string> StudyRunner::notes(const StudyDefinition& study, const std::vector<StudyCt>& cts) {
   std::vector<std::string> out{"X-rays: " + StudyXraySource::description()};
+  out.push_back(study.setup.xraysPerTrial
+                    ? fmt::format("every trial registers against X-rays of its own, all from its seed: the bone at the "
+                                  "study's true pose moved within +-{:g} mm and +-{:g} deg per axis about its centre, "
+                                  "its own foreign-object placement and noise (trial t of every condition: the same "
+                                  "pose and noise)",
+                                  kTrialSpread_mm, kTrialSpread_deg)
+                    : "every trial of a CT registers against one X-ray set simulated at the study's true pose "
+                      "(--one-xray-set): a condition's mean is one realization's optimum plus the search's spread");
   if (study.setup.method == DrrMethod::Transgraph) {
     out.push_back(fmt::format("DRRs: transgraph method, tables at a {:g} mm step built around each trial's start pose "
                               "(not the truth) and cached in {}; the 'setup s' column is their build or load time, "

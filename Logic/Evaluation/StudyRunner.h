@@ -1,11 +1,15 @@
 #pragma once
 // StudyRunner: runs the trials of a StudyDefinition that a TrialStore does not hold yet, and stores each one as soon
 // as it ends (resume). For every CT it fixes a true pose (the bone turned by (4, -3, 6) deg about its centre, the
-// centre at world (2, -3, 1.5) mm near the views' isocentre at the origin), builds the standard views and simulates
-// the X-rays once from the original CT (StudyXraySource); for every (CT, slice spacing, view count) it prepares one
-// RegistrationCase on the registration CT. Trial t of a condition starts at a random pose whose mean sTRE from the
-// truth is drawn in the condition's initial range, both from seed = setup.seed + t (so conditions see the same start
-// directions), and registers with that seed. Trials run on `jobs` threads (each registration is itself threaded).
+// centre at world (2, -3, 1.5) mm near the views' isocentre at the origin), builds the standard views and, for every
+// (CT, slice spacing, view count), prepares one RegistrationCase on the registration CT. The X-rays come from the
+// original CT (StudyXraySource). With setup.xraysPerTrial (the default) every trial simulates its own: the bone at
+// trialTruthPose (the true pose moved within +-kTrialSpread_mm and +-kTrialSpread_deg about its centre), its own
+// foreign objects and noise, swapped into the worker's case (RegistrationCase::replaceXray); otherwise all trials of a
+// CT share one set simulated at the true pose. Trial t of a condition starts at a random pose whose mean sTRE from its
+// truth is drawn in the condition's initial range; its truth, X-rays and start all come from seed = setup.seed + t (so
+// conditions see the same bone poses, noise and start directions: paired comparisons), and it registers with that
+// seed. Trials run on `jobs` threads (each registration is itself threaded).
 // Transgraph method: each trial gets a fresh copy of the case, so its tables are built around that trial's START pose
 // (the truth is unknown at run time), or loaded from setup.transgraphCacheDir when another condition with the same
 // registration CT, views and start (same trial index) built them; the time goes to TrialRecord::setupSeconds.
@@ -83,6 +87,16 @@ class StudyRunner {
                                              std::uint32_t seed, double& initialTarget_mm);
   /// The true pose T_world_from_ct used for a CT with this bone (see the file comment).
   static Eigen::Isometry3d truthPose(const BoneSurface& bone);
+  /// Bound of each translation (mm) and rotation (deg) parameter of a trial's bone pose about truthPose.
+  static constexpr double kTrialSpread_mm = 10.0;
+  static constexpr double kTrialSpread_deg = 5.0;
+  /// The true pose of the trial with this seed when every trial has its own X-rays: truthPose moved about the bone
+  /// centre by rotations about the world axes and a translation, each drawn uniformly within +-kTrialSpread_deg /
+  /// +-kTrialSpread_mm from the seed.
+  static Eigen::Isometry3d trialTruthPose(const BoneSurface& bone, std::uint32_t seed);
+  /// The noise and foreign-object seed of the X-rays of the trial with this seed (view v adds v): a hash of it, so
+  /// that neighbouring trials share no view's noise.
+  static std::uint32_t trialXraySeed(std::uint32_t seed);
   /// `base` with every stage's metric set for `measures` (NCC only, VLNC only, or unchanged).
   static RegistrationSchedule scheduleFor(const RegistrationSchedule& base, StudyMeasures measures);
 };

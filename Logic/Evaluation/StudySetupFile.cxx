@@ -60,11 +60,12 @@ std::string StudySetupFile::text(const StudyDefinition& study, const std::vector
     }
   }
   return fmt::format("study: {}\nquick: {}\ncts: {}\npreset: {}\ndetector: {}x{}\npixel_mm: {:g}\nsid_mm: {:g}\n"
-                     "sad_mm: {:g}\nmethod: {}\ntransgraph_spacing_mm: {:g}\nseed: {}\n{}",
+                     "sad_mm: {:g}\nmethod: {}\ntransgraph_spacing_mm: {:g}\nseed: {}\nxrays: {}\n{}",
                      study.name, study.quick ? "yes" : "no",
                      ctPaths.empty() ? "default" : fmt::format("{}", fmt::join(ctPaths, " ")), preset, d.cols, d.rows,
                      d.pixelSpacing_mm, d.sourceToDetector_mm, d.sourceToIsocentre_mm,
                      DrrRendererFactory::methodName(setup.method), setup.transgraphSpacing_mm, setup.seed,
+                     setup.xraysPerTrial ? "per trial" : "one set",
                      shard && shard->count() > 1
                          ? fmt::format("{}: {} of {} trials\n", kShardKey, shard->text(), shard->totalTrials())
                          : "");

@@ -86,7 +86,7 @@ Result<TrialStatus> parseTrialStatus(std::string_view text) {
 const std::vector<std::string>& TrialStore::columns() {
   static const std::vector<std::string> kColumns{
       "study",   "ct",          "condition", "scenario",     "variant",          "views",
-      "trial",   "seed",        "initial_target_mm", "initial_stre_mm", "stre_mean_mm", "stre_max_mm",
+      "trial",   "seed",        "truth_offset_mm", "initial_target_mm", "initial_stre_mm", "stre_mean_mm", "stre_max_mm",
       "mtre_mm", "rotation_deg", "translation_mm", "success",   "seconds",          "setup_seconds",
       "drrs",    "status",      "reason"};
   return kColumns;
@@ -97,9 +97,9 @@ std::string TrialStore::toCsv(const std::vector<TrialRecord>& records) {
   for (std::size_t c = 0; c < columns().size(); ++c) text += (c ? "," : "") + columns()[c];
   text += '\n';
   for (const TrialRecord& r : records) {
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csvField(r.study), csvField(r.ct),
-                        csvField(r.condition), csvField(r.scenario), csvField(r.variant), r.views, r.trial, r.seed,
-                        number(r.initialTarget_mm), number(r.initialStre_mm), number(r.error.streMean_mm),
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csvField(r.study),
+                        csvField(r.ct), csvField(r.condition), csvField(r.scenario), csvField(r.variant), r.views,
+                        r.trial, r.seed, number(r.truthOffset_mm), number(r.initialTarget_mm), number(r.initialStre_mm), number(r.error.streMean_mm),
                         number(r.error.streMax_mm), number(r.error.mtre_mm), number(r.error.rotation_deg),
                         number(r.error.translation_mm), r.success ? 1 : 0, number(r.seconds), number(r.setupSeconds), r.drrs,
                         trialStatusName(r.status), csvField(r.reason));
@@ -140,22 +140,22 @@ Result<std::vector<TrialRecord>> TrialStore::fromCsv(const std::string& text, co
     r.variant = f[4];
     int success = 0;
     const bool ok = parseInt(f[5], r.views) && parseInt(f[6], r.trial) && parseInt(f[7], r.seed) &&
-                    parseDouble(f[8], r.initialTarget_mm) && parseDouble(f[9], r.initialStre_mm) &&
-                    parseDouble(f[10], r.error.streMean_mm) && parseDouble(f[11], r.error.streMax_mm) &&
-                    parseDouble(f[12], r.error.mtre_mm) && parseDouble(f[13], r.error.rotation_deg) &&
-                    parseDouble(f[14], r.error.translation_mm) && parseInt(f[15], success) &&
-                    parseDouble(f[16], r.seconds) && parseDouble(f[17], r.setupSeconds) && parseInt(f[18], r.drrs);
+                    parseDouble(f[8], r.truthOffset_mm) && parseDouble(f[9], r.initialTarget_mm) && parseDouble(f[10], r.initialStre_mm) &&
+                    parseDouble(f[11], r.error.streMean_mm) && parseDouble(f[12], r.error.streMax_mm) &&
+                    parseDouble(f[13], r.error.mtre_mm) && parseDouble(f[14], r.error.rotation_deg) &&
+                    parseDouble(f[15], r.error.translation_mm) && parseInt(f[16], success) &&
+                    parseDouble(f[17], r.seconds) && parseDouble(f[18], r.setupSeconds) && parseInt(f[19], r.drrs);
     if (!ok) {
       return fail(fmt::format("{} line {}: a number field cannot be read; fix or delete the line to resume", where,
                               lineNumber));
     }
-    auto status = parseTrialStatus(f[19]);
+    auto status = parseTrialStatus(f[20]);
     if (!status) {
       return fail(fmt::format("{} line {}: {}; fix or delete the line to resume", where, lineNumber, status.error()));
     }
     r.success = success != 0;
     r.status = status.value();
-    r.reason = f[20];
+    r.reason = f[21];
     records.push_back(std::move(r));
   }
   return records;

@@ -36,7 +36,8 @@ struct TrialRecord {
   std::string variant;
   int views = 0;
   int trial = 0;                  ///< 0-based index within the condition
-  std::uint32_t seed = 0;         ///< start pose and search seed
+  std::uint32_t seed = 0;         ///< start pose and search seed (and, with per-trial X-rays, their bone pose and noise)
+  double truthOffset_mm = 0.0;    ///< mean bone-surface distance of the trial's true pose from the study's (0: one X-ray set)
   double initialTarget_mm = 0.0;  ///< the initial mean sTRE asked for
   double initialStre_mm = 0.0;    ///< the initial mean sTRE measured
   PoseError error;                ///< of the final pose (NaN for a failed trial)

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "Base/TextFile.h"
@@ -91,7 +92,7 @@ class ScopedDataDir {
 /// The setup.txt of `evaluate --study table2 --quick` (every default spelled out).
 const std::string kQuickTable2Setup =
     "study: table2\nquick: yes\ncts: default\npreset: fast\ndetector: 128x128\npixel_mm: 2.4\nsid_mm: 1000\n"
-    "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\n";
+    "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\nxrays: per trial\n";
 
 }  // namespace
 
@@ -99,7 +100,8 @@ TEST(EvaluateCommand, QuickTable2WritesTrialsChartsAndTheTableBesideThePaper) {
   const auto out = fct::test::scratchDir() / "table2";
   runQuickStudy("table2", out);
   const std::string csv = fct::test::readText(out / "trials.csv");
-  EXPECT_EQ(csv.rfind("study,ct,condition,scenario,variant,views,trial,seed,initial_target_mm,initial_stre_mm,"
+  EXPECT_EQ(csv.rfind("study,ct,condition,scenario,variant,views,trial,seed,truth_offset_mm,initial_target_mm,"
+                      "initial_stre_mm,"
                       "stre_mean_mm,stre_max_mm,mtre_mm,rotation_deg,translation_mm,success,seconds,setup_seconds,drrs,status,"
                       "reason\n",
                       0),
@@ -111,6 +113,29 @@ TEST(EvaluateCommand, QuickTable2WritesTrialsChartsAndTheTableBesideThePaper) {
   EXPECT_NE(fct::test::readText(out / "setup.txt").find("detector: 128x128\npixel_mm: 2.4\n"), std::string::npos);
   EXPECT_NE(report.find("paper: mean (max) sTRE"), std::string::npos);
   EXPECT_NE(report.find("![Success rate by scenario](table2_success.png)"), std::string::npos);
+}
+
+TEST(EvaluateCommand, EveryTrialHasItsOwnBonePoseUnlessOneXraySetIsAsked) {
+  const auto own = fct::test::scratchDir() / "own";
+  runQuickStudy("table2", own);
+  const auto ownTrials = fct::TrialStore::open(own / "trials.csv").value().records();
+  ASSERT_EQ(ownTrials.size(), 6u);
+  std::set<double> offsets;
+  for (const fct::TrialRecord& r : ownTrials) {
+    EXPECT_GT(r.truthOffset_mm, 0.5) << r.condition << " trial " << r.trial << ": the bone was moved";
+    offsets.insert(r.truthOffset_mm);
+  }
+  EXPECT_EQ(offsets.size(), 2u) << "trial t of every condition has the same pose; the two trials differ";
+  EXPECT_NE(fct::test::readText(own / "report.md").find("every trial registers against X-rays of its own"),
+            std::string::npos);
+
+  const auto shared = fct::test::scratchDir() / "shared";
+  runQuickStudy("table2", shared, "--one-xray-set");
+  for (const fct::TrialRecord& r : fct::TrialStore::open(shared / "trials.csv").value().records()) {
+    EXPECT_EQ(r.truthOffset_mm, 0.0) << r.condition << " trial " << r.trial;
+  }
+  EXPECT_NE(fct::test::readText(shared / "setup.txt").find("\nxrays: one set\n"), std::string::npos);
+  EXPECT_NE(fct::test::readText(shared / "report.md").find("--one-xray-set"), std::string::npos);
 }
 
 TEST(EvaluateCommand, QuickCaptureStudyRuns) { runQuickStudy("capture", fct::test::scratchDir() / "capture"); }

@@ -113,7 +113,7 @@ TEST(EvaluateCommand, MergeOfMismatchedOrIncompleteShardsFailsWithOneLineAndWrit
   ASSERT_TRUE(fct::TextFile::writeAtomically(
                   dir / "s1" / "setup.txt",
                   "study: table2\nquick: yes\ncts: default\npreset: fast\ndetector: 128x128\npixel_mm: 2.4\nsid_mm: 1000\n"
-                  "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\nshard: 1/2 of 6 trials\n")
+                  "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\nxrays: per trial\nshard: 1/2 of 6 trials\n")
                   .ok());
   const auto merge = [&](const std::string& options) {
     return fct::test::runCli(fmt::format("evaluate --study table2 --quick {} --merge '{}' --out '{}'", options,

@@ -1,10 +1,13 @@
-// StudyRunner and StudyXraySource: schedule variants, the registration CT per scenario, and bad study input (checked
-// before any simulation or registration).
+// StudyRunner and StudyXraySource: per-trial true poses, schedule variants, the registration CT per scenario, and bad
+// study input (checked before any simulation or registration).
 #include <gtest/gtest.h>
+
+#include <set>
 
 #include "Evaluation/StudyCatalog.h"
 #include "Evaluation/StudyRunner.h"
 #include "Evaluation/StudyXraySource.h"
+#include "Geometry/RigidPose.h"
 #include "InitialPose/SetupPose.h"
 #include "Simulation/StandardViews.h"
 #include "TestSupport.h"
@@ -63,6 +66,32 @@ TEST(StudyRunner, StartPosesRotateAboutTheBoneCentreWithinTheBinOrComeFromTheSup
   c.initialLow_mm = c.initialHigh_mm = 12.0;
   fct::StudyRunner::startPose(c, bone, T_truth, cameras, 7, target_mm).value();
   EXPECT_DOUBLE_EQ(target_mm, 12.0);
+}
+
+TEST(StudyRunner, TrialTruthPoseIsSeededAndMovesTheBoneWithinTheSpreadAboutItsCentre) {
+  const fct::Volume ct = tinyCt(2.0);
+  const fct::BoneSurface bone = fct::BoneSurface::extract(ct).value();
+  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(bone);
+  const Eigen::Vector3d centre_world_mm = T_truth * bone.centroid_ct_mm();
+  std::set<std::uint32_t> xraySeeds;
+  double largestMove_mm = 0.0;
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) {
+    const Eigen::Isometry3d T_trial = fct::StudyRunner::trialTruthPose(bone, seed);
+    EXPECT_TRUE(T_trial.isApprox(fct::StudyRunner::trialTruthPose(bone, seed))) << "seeded";
+    EXPECT_FALSE(T_trial.isApprox(fct::StudyRunner::trialTruthPose(bone, seed + 1))) << seed;
+    // The move M = T_trial * T_truth^-1 about the bone centre: per-axis bounds on its parameters.
+    const Eigen::Isometry3d M = T_trial * T_truth.inverse();
+    const fct::PoseParameters move = fct::RigidPose::fromTransform(M, centre_world_mm).value();
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(std::abs(move.rotation_deg[a]), fct::StudyRunner::kTrialSpread_deg + 1e-9) << seed;
+      EXPECT_LE(std::abs(move.translation_mm[a]), fct::StudyRunner::kTrialSpread_mm + 1e-9) << seed;
+    }
+    largestMove_mm = std::max(largestMove_mm, move.translation_mm.cwiseAbs().maxCoeff());
+    // View v of a trial uses trialXraySeed + v: no two of 40 trials' 5 views share a noise seed.
+    for (std::uint32_t v = 0; v < 5; ++v) xraySeeds.insert(fct::StudyRunner::trialXraySeed(seed) + v);
+  }
+  EXPECT_GT(largestMove_mm, 0.5 * fct::StudyRunner::kTrialSpread_mm) << "the spread is used";
+  EXPECT_EQ(xraySeeds.size(), 200u);
 }
 
 TEST(StudyRunner, ScheduleForMeasuresKeepsOrReplacesEveryStageMetric) {
@@ -128,14 +157,20 @@ TEST(StudyXraySource, RegistrationCtIsTheOriginalUnlessTheScenarioAsksForCoarser
 TEST(StudyRunner, NotesSayWhenAScenarioKeepsTheOriginalCt) {
   const auto study = fct::StudyCatalog::define("table2", false, {"pelvis"}).value();
   const std::vector<std::string> notes = fct::StudyRunner::notes(study, {{"pelvis", tinyCt(3.0)}});
-  // X-ray model, DRR method, the default preset's trilinear final stage, 'realistic' (2.4 mm < 3 mm); 'bad' (4.2 mm)
-  // is resampled.
-  ASSERT_EQ(notes.size(), 4u);
+  // X-ray model, per-trial X-rays, DRR method, the default preset's trilinear final stage, 'realistic' (2.4 mm <
+  // 3 mm); 'bad' (4.2 mm) is resampled.
+  ASSERT_EQ(notes.size(), 5u);
   EXPECT_EQ(notes[0].rfind("X-rays: FluoroscopySimulator", 0), 0u);
-  EXPECT_EQ(notes[1], "DRRs: siddon method");
-  EXPECT_EQ(notes[2], "the preset's stage 'vlnc-rois-1:1' renders its DRRs with the raycast method (a sample every 1 "
+  EXPECT_EQ(notes[1].rfind("every trial registers against X-rays of its own", 0), 0u) << notes[1];
+  EXPECT_EQ(notes[2], "DRRs: siddon method");
+  EXPECT_EQ(notes[3], "the preset's stage 'vlnc-rois-1:1' renders its DRRs with the raycast method (a sample every 1 "
                       "voxel), whatever the study's");
-  EXPECT_NE(notes[3].find("scenario 'realistic'"), std::string::npos) << notes[3];
+  EXPECT_NE(notes[4].find("scenario 'realistic'"), std::string::npos) << notes[4];
+  auto oneSet = study;
+  oneSet.setup.xraysPerTrial = false;
+  EXPECT_EQ(fct::StudyRunner::notes(oneSet, {{"pelvis", tinyCt(3.0)}})[1].rfind("every trial of a CT registers against "
+                                                                                 "one X-ray set", 0),
+            0u);
 }
 
 TEST(StudyRunner, ResolveSliceSpacingsGivesTheSpacingActuallyUsed) {

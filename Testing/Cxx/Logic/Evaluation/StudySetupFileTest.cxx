@@ -23,7 +23,7 @@ fct::StudyDefinition quickTable2() {
 TEST(StudySetupFile, TextSpellsOutEveryOptionThatChangesResults) {
   EXPECT_EQ(StudySetupFile::text(quickTable2(), {}),
             "study: table2\nquick: yes\ncts: default\npreset: fast\ndetector: 128x128\npixel_mm: 2.4\nsid_mm: 1000\n"
-            "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\n");
+            "sad_mm: 700\nmethod: siddon\ntransgraph_spacing_mm: 6\nseed: 1\nxrays: per trial\n");
   const std::string text = StudySetupFile::text(quickTable2(), {"a.nrrd", "b.nii.gz"});
   EXPECT_NE(text.find("\ncts: a.nrrd b.nii.gz\n"), std::string::npos) << text;
 }

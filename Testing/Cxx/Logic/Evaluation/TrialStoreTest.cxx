@@ -21,6 +21,7 @@ fct::TrialRecord record(const std::string& condition, int trial, fct::TrialStatu
   r.views = 3;
   r.trial = trial;
   r.seed = 1 + trial;
+  r.truthOffset_mm = 7.25;
   r.initialTarget_mm = 10.0;
   r.initialStre_mm = 10.0004;
   r.error = fct::PoseError{0.25, 0.5, 0.3, 0.2, 0.1};
@@ -45,6 +46,7 @@ TEST(TrialStore, RoundTripsRecordsThroughCsvWithQuotesAndNaN) {
   EXPECT_EQ(back.value()[0].condition, "phantom/ideal");
   EXPECT_NEAR(back.value()[0].error.streMax_mm, 0.5, 1e-9);
   EXPECT_EQ(back.value()[0].drrs, 2900);
+  EXPECT_NEAR(back.value()[0].truthOffset_mm, 7.25, 1e-9);
   EXPECT_TRUE(back.value()[0].success);
   EXPECT_EQ(back.value()[1].reason, failed.reason);
   EXPECT_TRUE(std::isnan(back.value()[1].error.streMean_mm));
