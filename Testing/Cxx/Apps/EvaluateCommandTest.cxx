@@ -131,7 +131,8 @@ TEST(EvaluateCommand, EveryTrialHasItsOwnBonePoseUnlessOneXraySetIsAsked) {
 
   const auto shared = fct::test::scratchDir() / "shared";
   runQuickStudy("table2", shared, "--one-xray-set");
-  for (const fct::TrialRecord& r : fct::TrialStore::open(shared / "trials.csv").value().records()) {
+  const fct::TrialStore sharedStore = fct::TrialStore::open(shared / "trials.csv").value();
+  for (const fct::TrialRecord& r : sharedStore.records()) {
     EXPECT_EQ(r.truthOffset_mm, 0.0) << r.condition << " trial " << r.trial;
   }
   EXPECT_NE(fct::test::readText(shared / "setup.txt").find("\nxrays: one set\n"), std::string::npos);
