@@ -33,8 +33,8 @@ namespace {
 constexpr int kMaxViews = 5;
 
 /// Everything about one CT that its trials share: error measures, truth, the views and the X-rays simulated at the
-/// truth (all views), without and (when a scenario needs them) with foreign objects. The cases are prepared on those
-/// X-rays; with per-trial X-rays each trial then swaps in its own.
+/// truth (all views), without and (when a scenario needs them and the trials share one set) with foreign objects. The
+/// cases are prepared on those X-rays; with per-trial X-rays each trial then swaps in its own.
 struct CtScene {
   const Volume* ct = nullptr;
   std::unique_ptr<PoseErrorMetrics> metrics;
@@ -263,9 +263,12 @@ Result<CtScenes> simulateScenes(const StudyDefinition& study, const std::vector<
   for (const StudyCt& ct : cts) {
     const int viewCount = viewsNeeded(pending, ct.label);
     if (viewCount == 0) continue;
-    const bool withObjects = std::any_of(pending.begin(), pending.end(), [&](const PendingTrial& p) {
-      return p.condition->ct == ct.label && StudyCatalog::scenarioHasForeignObjects(p.condition->scenario);
-    });
+    // Per-trial X-rays replace the scene's in every case, so the cases need only the tool-free set.
+    const bool withObjects = !study.setup.xraysPerTrial &&
+                             std::any_of(pending.begin(), pending.end(), [&](const PendingTrial& p) {
+                               return p.condition->ct == ct.label &&
+                                      StudyCatalog::scenarioHasForeignObjects(p.condition->scenario);
+                             });
     auto scene = simulateScene(ct, viewCount, withObjects, study.setup, options);
     if (!scene) return fail(scene.error());
     scenes.emplace(ct.label, std::move(scene).value());
@@ -304,7 +307,8 @@ Result<CasePrototypes> prepareCases(const StudyDefinition& study, const std::vec
     auto registrationCt = StudyXraySource::registrationCt(*scene.ct, c.sliceSpacing_mm);
     if (!registrationCt) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, registrationCt.error()));
     const std::vector<RegistrationView>& xrays =
-        StudyCatalog::scenarioHasForeignObjects(c.scenario) ? scene.xraysWithObjects : scene.xrays;
+        scene.xraysWithObjects.empty() || !StudyCatalog::scenarioHasForeignObjects(c.scenario) ? scene.xrays
+                                                                                                : scene.xraysWithObjects;
     const std::vector<RegistrationView> views(xrays.begin(), xrays.begin() + c.viewCount);
     auto created = RegistrationCase::create(registrationCt.value(), views, caseOptions);
     if (!created) return fail(fmt::format("CT '{}', scenario '{}': {}", c.ct, c.scenario, created.error()));

@@ -24,8 +24,8 @@ class StudySetupFile {
 
   /// The setup text of `study`: study, quick, cts (`ctPaths` as given; "default" when empty), preset (a preset file
   /// with its size and FNV-1a hash, so an edited file counts as another preset), detector, pixel_mm, sid_mm, sad_mm,
-  /// method, transgraph_spacing_mm, seed, xrays ("per trial" or "one set"); then "shard: K/N of T trials" for a `shard` of more than one (none for the
-  /// whole study).
+  /// method, transgraph_spacing_mm, seed, xrays ("per trial" or "one set"); then "shard: K/N of T trials" for a
+  /// `shard` of more than one (none for the whole study).
   static std::string text(const StudyDefinition& study, const std::vector<std::string>& ctPaths,
                           const StudyShard* shard = nullptr);
 

@@ -85,10 +85,10 @@ Result<TrialStatus> parseTrialStatus(std::string_view text) {
 
 const std::vector<std::string>& TrialStore::columns() {
   static const std::vector<std::string> kColumns{
-      "study",   "ct",          "condition", "scenario",     "variant",          "views",
-      "trial",   "seed",        "truth_offset_mm", "initial_target_mm", "initial_stre_mm", "stre_mean_mm", "stre_max_mm",
-      "mtre_mm", "rotation_deg", "translation_mm", "success",   "seconds",          "setup_seconds",
-      "drrs",    "status",      "reason"};
+      "study",        "ct",           "condition",       "scenario",          "variant",         "views",
+      "trial",        "seed",         "truth_offset_mm", "initial_target_mm", "initial_stre_mm", "stre_mean_mm",
+      "stre_max_mm",  "mtre_mm",      "rotation_deg",    "translation_mm",    "success",         "seconds",
+      "setup_seconds", "drrs",        "status",          "reason"};
   return kColumns;
 }
 
