@@ -16,6 +16,8 @@ namespace fct {
 namespace {
 
 constexpr float kHigh = std::numeric_limits<float>::max();
+/// The dilation covers at least the blurred edge of a shadow (PSF and pixel phase), whatever the pixel size.
+constexpr int kMinDilation_px = 3;
 
 /// Grey-level opening of `p` (invalid pixels hold kHigh) with a square window of `side` px, over the valid pixels
 /// only: invalid pixels never win the erosion (+max) nor, where the whole erosion window was invalid, the dilation.
@@ -71,6 +73,35 @@ double sagitta_px(const std::vector<cv::Point>& pixels) {
   return std::abs(coefficients.at<double>(0)) * halfLength * halfLength;
 }
 
+/// The straight bars inside a piece that is not straight as a whole (a K-wire crossing a screw, a wire over a bone
+/// rim): the pixels within `halfWidth_px` of each line segment of at least `minLength_px` that a probabilistic Hough
+/// transform finds among the piece's pixels. Bars may share pixels.
+std::vector<std::vector<cv::Point>> straightBars(const std::vector<cv::Point>& pixels, double minLength_px,
+                                                 double halfWidth_px) {
+  const cv::Rect box = cv::boundingRect(pixels);
+  cv::Mat local = cv::Mat::zeros(box.height, box.width, CV_8U);
+  for (const cv::Point& pixel : pixels) local.at<std::uint8_t>(pixel - box.tl()) = 255;
+  std::vector<cv::Vec4i> segments;
+  cv::HoughLinesP(local, segments, 1.0, CV_PI / 180.0, std::max(2, static_cast<int>(minLength_px / 2.0)), minLength_px,
+                  2.0);
+  std::vector<std::vector<cv::Point>> bars;
+  for (const cv::Vec4i& segment : segments) {
+    const cv::Point2d a(segment[0] + box.x, segment[1] + box.y);
+    const cv::Point2d b(segment[2] + box.x, segment[3] + box.y);
+    const cv::Point2d ab = b - a;
+    const double lengthSquared = std::max(1e-12, ab.dot(ab));
+    std::vector<cv::Point> bar;
+    for (const cv::Point& pixel : pixels) {
+      const cv::Point2d ap = cv::Point2d(pixel) - a;
+      const double t = std::clamp(ap.dot(ab) / lengthSquared, 0.0, 1.0);
+      const cv::Point2d offset = ap - t * ab;
+      if (offset.dot(offset) <= halfWidth_px * halfWidth_px) bar.push_back(pixel);
+    }
+    bars.push_back(std::move(bar));
+  }
+  return bars;
+}
+
 }  // namespace
 
 Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, const ValidMask& mask,
@@ -94,17 +125,20 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       !positive(o.contrastWindow_mm) || !positive(o.minExcess) || !positive(o.maxContrastRatio) ||
       !positive(o.maxSagitta_mm) || !positive(o.seedContrastRatio) || !positive(o.denseExcess) ||
       !positive(o.denseContrastRatio) || !positive(o.veryDenseExcess) || !(o.minLength_mm >= 0.0) ||
-      !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) || !std::isfinite(o.growExcess) ||
-      !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) || o.dilation_px < 0) {
+      !(o.minClippedLength_mm >= 0.0) || !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) ||
+      !std::isfinite(o.growExcess) ||
+      !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) || !(o.dilation_mm >= 0.0) ||
+      !std::isfinite(o.dilation_mm)) {
     return fail(fmt::format("metal detection options: assumed pixel spacing {} mm, windows ({}, {}, {} mm), "
                             "minimum excess {}, dense and very dense excesses ({}, {}), contrast ratios ({}, {}, {}) "
-                            "and sagitta {} mm must be > 0; lengths ({}, {}, {} mm), growth distance {} mm and "
-                            "dilation {} px >= 0; fix the settings",
+                            "and sagitta {} mm must be > 0; lengths ({}, {}, {}, {} mm), growth distance {} mm and "
+                            "dilation {} mm >= 0; fix the settings",
                             o.assumedPixelSpacing_mm, o.backgroundWindow_mm, o.narrowWindow_mm,
                             o.contrastWindow_mm, o.minExcess, o.denseExcess, o.veryDenseExcess,
                             o.maxContrastRatio, o.seedContrastRatio, o.denseContrastRatio, o.maxSagitta_mm,
-                            o.minLength_mm, o.minDenseLength_mm, o.minVeryDenseLength_mm, o.growDistance_mm,
-                            o.dilation_px));
+                            o.minLength_mm, o.minClippedLength_mm, o.minDenseLength_mm, o.minVeryDenseLength_mm,
+                            o.growDistance_mm,
+                            o.dilation_mm));
   }
   const auto toPixels = [spacing_mm](double length_mm) {
     return static_cast<int>(std::lround(length_mm / spacing_mm));
@@ -157,6 +191,10 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       piece.wideExcessSum += wideExcess.ptr<float>()[i];
       piece.contrastRatioSum += contrast.ptr<float>()[i] / narrowExcess.ptr<float>()[i];
     }
+    // Pixels next to an invalid pixel or the image's border: a piece reaching them is cut by the field's edge.
+    cv::Mat interior;
+    cv::erode(valid != 0, interior, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)), cv::Point(-1, -1), 1,
+              cv::BORDER_CONSTANT, cv::Scalar(0));
     cv::Mat seeds = cv::Mat::zeros(rows, cols, CV_8U);
     for (std::size_t label = 1; label < pieces.size(); ++label) {
       const Piece& piece = pieces[label];
@@ -167,10 +205,29 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       const double ratio = piece.contrastRatioSum / count;
       // Very dense pieces need no shape test (crossing wires make an X); the others must be straight.
       const bool veryDense = wide >= o.veryDenseExcess && length_mm >= o.minVeryDenseLength_mm;
-      const bool longThin = length_mm >= o.minLength_mm && ratio < o.seedContrastRatio;
+      const bool clipped = std::any_of(piece.pixels.begin(), piece.pixels.end(), [&interior](const cv::Point& pixel) {
+        return interior.at<std::uint8_t>(pixel) == 0;
+      });
+      const bool longThin =
+          length_mm >= (clipped ? o.minClippedLength_mm : o.minLength_mm) && ratio < o.seedContrastRatio;
       const bool dense = wide >= o.denseExcess && length_mm >= o.minDenseLength_mm && ratio < o.denseContrastRatio;
       if (veryDense || ((longThin || dense) && sagitta_px(piece.pixels) * spacing_mm <= o.maxSagitta_mm)) {
         for (const cv::Point& pixel : piece.pixels) seeds.at<std::uint8_t>(pixel) = 1;
+        continue;
+      }
+      // Not straight as a whole: a long straight bar of it with little bone contrast seeds (a wire crossing a screw).
+      if (length_mm < o.minLength_mm) continue;
+      for (const std::vector<cv::Point>& bar :
+           straightBars(piece.pixels, o.minLength_mm / spacing_mm, 0.25 * narrowWindow_px)) {
+        if (bar.size() < 3) continue;
+        const cv::RotatedRect barBox = cv::minAreaRect(bar);
+        double barRatio = 0.0;
+        for (const cv::Point& pixel : bar) barRatio += contrast.at<float>(pixel) / narrowExcess.at<float>(pixel);
+        barRatio /= static_cast<double>(bar.size());
+        if ((std::max(barBox.size.width, barBox.size.height) + 1.0) * spacing_mm >= o.minLength_mm &&
+            barRatio < o.seedContrastRatio && sagitta_px(bar) * spacing_mm <= o.maxSagitta_mm) {
+          for (const cv::Point& pixel : bar) seeds.at<std::uint8_t>(pixel) = 1;
+        }
       }
     }
 
@@ -185,7 +242,7 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       if (cv::countNonZero(next != metal) == 0) break;
       metal = next;
     }
-    if (o.dilation_px > 0) metal = grown(metal, o.dilation_px);
+    if (o.dilation_mm > 0.0) metal = grown(metal, std::max(kMinDilation_px, toPixels(o.dilation_mm)));
     MetalMask result{mask, 0};
     for (std::size_t i = 0; i < mask.valid.size(); ++i) {
       if (metal.data[i] && result.mask.valid[i]) {

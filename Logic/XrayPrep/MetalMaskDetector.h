@@ -15,10 +15,14 @@
 //   excess >= veryDenseExcess, length >= minVeryDenseLength_mm), or when it is straight (the sagitta of a parabola
 //   fitted across the piece's axis is at most maxSagitta_mm: a rim is an arc) and either long with little bone
 //   contrast (length >= minLength_mm, mean contrast / narrow excess < seedContrastRatio) or dense (mean wide excess
-//   >= denseExcess, length >= minDenseLength_mm, mean ratio < denseContrastRatio);
+//   >= denseExcess, length >= minDenseLength_mm, mean ratio < denseContrastRatio). A piece that reaches the edge of
+//   the valid pixels is cut by it (a K-wire entering the field): only its visible part can be measured, so it counts
+//   as long from minClippedLength_mm on. A piece that is not straight as a whole (a wire crossing a screw or a bone
+//   rim) seeds where a probabilistic Hough transform finds a straight bar of it at least minLength_mm long whose
+//   pixels have the long piece's low mean contrast ratio;
 // - the seeds grow along connected pixels still minExcess above the wide and growExcess above the narrow surroundings
 //   for up to growDistance_mm (the rest of a wire over dense bone, a screw head), and the result is dilated by
-//   dilation_px to cover the blurred edge of the shadow.
+//   dilation_mm (at least 3 px) to cover the blurred edge of the shadow and the glare around it.
 // Not found: objects wider than the wide window, curved or crossing metal that is not very dense, metal
 // that stands less than minExcess above its surroundings (contrast-processed images; thin wires over thick anatomy
 // at coarse pixels).
@@ -42,6 +46,7 @@ struct MetalMaskOptions {
   double maxSagitta_mm = 1.5;         ///< a piece bends at most this much from a straight line
   double minLength_mm = 15.0;         ///< a long piece seeds metal when its mean contrast ratio is below ...
   double seedContrastRatio = 0.5;     ///< ... this
+  double minClippedLength_mm = 4.0;   ///< the length that counts as long for a piece reaching the valid pixels' edge
   double denseExcess = 2.3;           ///< a piece with this mean wide excess seeds metal when ...
   double minDenseLength_mm = 10.0;    ///< ... at least this long and ...
   double denseContrastRatio = 0.6;    ///< ... its mean contrast ratio is below this
@@ -49,7 +54,7 @@ struct MetalMaskOptions {
   double minVeryDenseLength_mm = 2.0;  ///< ... at least this long
   double growExcess = 0.5;            ///< seeds grow into pixels this far above the narrow opening ...
   double growDistance_mm = 25.0;      ///< ... up to this far
-  int dilation_px = 3;                ///< metal pixels are grown by this radius (square) before exclusion
+  double dilation_mm = 2.7;          ///< metal pixels are grown by this radius (square, at least 3 px) before exclusion
 };
 
 /// What was found.

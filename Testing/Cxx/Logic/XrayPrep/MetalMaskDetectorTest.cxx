@@ -3,6 +3,7 @@
 // nothing, and bad input fails.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "XrayPrep/MetalMaskDetector.h"
@@ -28,17 +29,17 @@ fct::FloatImage boneImage(float barExcess) {
 TEST(MetalMaskDetector, MasksDarkBarWithDilationButNotBone) {
   const fct::ValidMask field = fct::ValidMask::allValid(160, 120);
   fct::MetalMaskOptions options;
-  options.dilation_px = 2;
+  options.dilation_mm = 1.6;  // 4 px at the assumed 0.4 mm
   const auto metal = fct::MetalMaskDetector(options).detect(boneImage(3.0f), field);
   ASSERT_TRUE(metal.ok()) << metal.error();
   const fct::ValidMask& mask = metal.value().mask;
   EXPECT_FALSE(mask.isValid(111, 60));
-  EXPECT_FALSE(mask.isValid(108, 60)) << "dilated by 2 px";
-  EXPECT_TRUE(mask.isValid(107, 60));
+  EXPECT_FALSE(mask.isValid(106, 60)) << "dilated by 4 px";
+  EXPECT_TRUE(mask.isValid(105, 60));
   EXPECT_TRUE(mask.isValid(111, 10)) << "beyond the bar's end plus dilation";
   EXPECT_TRUE(mask.isValid(60, 60)) << "bone centre";
   EXPECT_TRUE(mask.isValid(30, 60)) << "bone edge";
-  EXPECT_EQ(metal.value().metalPixelCount, static_cast<std::size_t>((3 + 4) * (80 + 4)));
+  EXPECT_EQ(metal.value().metalPixelCount, static_cast<std::size_t>((3 + 8) * (80 + 8)));
 }
 
 TEST(MetalMaskDetector, OneSidedCurvedRimIsBoneNotMetal) {
@@ -116,4 +117,44 @@ TEST(MetalMaskDetector, WindowInMillimetresFollowsThePixelSpacing) {
   ASSERT_TRUE(coarse.ok()) << coarse.error();
   EXPECT_TRUE(coarse.value().mask.isValid(111, 60));
   EXPECT_FALSE(fct::MetalMaskDetector().detect(image, field, -1.0).ok());
+}
+
+namespace {
+
+/// Adds `excess` to the pixels of `image` within `halfWidth_px` of the segment a-b (a wire or a screw shaft).
+void addBar(fct::FloatImage& image, double ax, double ay, double bx, double by, double halfWidth_px, float excess) {
+  const double dx = bx - ax, dy = by - ay, lengthSquared = dx * dx + dy * dy;
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) {
+      const double t = std::clamp(((col - ax) * dx + (row - ay) * dy) / lengthSquared, 0.0, 1.0);
+      if (std::hypot(col - ax - t * dx, row - ay - t * dy) <= halfWidth_px) image.at(col, row) += excess;
+    }
+  }
+}
+
+}  // namespace
+
+TEST(MetalMaskDetector, ShortWireStubIsMetalOnlyWhereTheFieldEdgeCutsIt) {
+  // At 0.4 mm pixels a thin steel wire (adding 1.8) shows 8 mm of itself where it enters through the bottom edge, and
+  // another 8 mm piece of wire lies inside the field. Only the first can be part of a longer wire.
+  fct::FloatImage image = boneImage(0.0f);
+  addBar(image, 140.0, 100.0, 140.0, 125.0, 1.0, 1.8f);
+  addBar(image, 20.0, 20.0, 20.0, 40.0, 1.0, 1.8f);
+  const auto metal = fct::MetalMaskDetector().detect(image, fct::ValidMask::allValid(160, 120), 0.4);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  EXPECT_FALSE(metal.value().mask.isValid(140, 110)) << "the stub cut by the field edge";
+  EXPECT_TRUE(metal.value().mask.isValid(20, 30)) << "a short mark inside the field is not seeded";
+}
+
+TEST(MetalMaskDetector, WireCrossingAScrewIsStillFoundAsAStraightBar) {
+  // At 0.4 mm pixels a 60 mm steel wire (adding 1.8) crosses the end of a titanium screw shaft (7 px wide, adding
+  // 1.5): together they make one T-shaped piece that is not straight as a whole.
+  fct::FloatImage image = fct::FloatImage::filled(240, 200, 1.0f);
+  addBar(image, 30.0, 40.0, 180.0, 40.0, 1.0, 1.8f);
+  addBar(image, 160.0, 30.0, 160.0, 80.0, 3.0, 1.5f);
+  const auto metal = fct::MetalMaskDetector().detect(image, fct::ValidMask::allValid(240, 200), 0.4);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  EXPECT_FALSE(metal.value().mask.isValid(60, 40)) << "the wire";
+  EXPECT_FALSE(metal.value().mask.isValid(160, 45)) << "the screw where the wire meets it";
+  EXPECT_TRUE(metal.value().mask.isValid(60, 150)) << "soft tissue";
 }
