@@ -445,7 +445,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       "Landmark pair file {\"ct\": \"points.mrk.json\", \"image\": \"clicks.json\", \"method\": "
       "\"reprojection\"|\"triangulation\"} (paths relative to it)");
   init->excludes(landmarks);
-  command->add_option("--preset", options->preset, "Schedule: 'clinical', 'accurate' (5x the final stage's pixels), 'paper' (the paper's), 'fast' or a preset JSON file")
+  command->add_option("--preset", options->preset, "Schedule: 'clinical', 'accurate' (every valid pixel in the last stage), 'paper' (the paper's), 'fast' or a preset JSON file")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the random searches")->capture_default_str();
   command->add_option("--method", options->method,

@@ -100,7 +100,7 @@ std::string registerModuleXml() {
       <name>preset</name>
       <longflag>preset</longflag>
       <label>Preset</label>
-      <description><![CDATA[Registration schedule: 'clinical' (the default), 'accurate' (five times the final stage's pixels: a smaller bias at three to four times the time), 'paper' (the published three stages) or 'fast'.]]></description>
+      <description><![CDATA[Registration schedule: 'clinical' (the default), 'accurate' (every valid pixel in the last stage: a smaller error at about twice the time), 'paper' (the published three stages) or 'fast'.]]></description>
       <default>clinical</default>
 {}    </string-enumeration>
     <integer>

@@ -163,7 +163,7 @@ TEST(StudyRunner, NotesSayWhenAScenarioKeepsTheOriginalCt) {
   EXPECT_EQ(notes[0].rfind("X-rays: FluoroscopySimulator", 0), 0u);
   EXPECT_EQ(notes[1].rfind("every trial registers against X-rays of its own", 0), 0u) << notes[1];
   EXPECT_EQ(notes[2], "DRRs: siddon method");
-  EXPECT_EQ(notes[3], "the preset's stage 'vlnc-rois-1:1' renders its DRRs with the raycast method (a sample every 1 "
+  EXPECT_EQ(notes[3], "the preset's stage 'vlnc-rois-1:4' renders its DRRs with the raycast method (a sample every 1 "
                       "voxel), whatever the study's");
   EXPECT_NE(notes[4].find("scenario 'realistic'"), std::string::npos) << notes[4];
   auto oneSet = study;
