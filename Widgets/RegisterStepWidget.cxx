@@ -37,7 +37,8 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   auto* form = new QFormLayout(optionsBox);
   m_presetCombo = new QComboBox(optionsBox);
   for (const std::string& name : RegistrationSchedule::builtinNames()) m_presetCombo->addItem(QString::fromStdString(name));
-  m_presetCombo->setToolTip(tr("clinical (default): the paper's accuracy at a tenth of its time; fast: a small genetic search, "
+  m_presetCombo->setToolTip(tr("clinical (default): the paper's stages at a small fraction of its time, ending at "
+                               "1:4; accurate: clinical with every valid pixel at 1:4; fast: a small genetic search, "
                                "then VLNC on ROIs at 1:16, 1:4, 1:1; paper: the paper's three stages with n = 4 genetic "
                                "guesses"));
   form->addRow(tr("Preset"), m_presetCombo);

@@ -127,7 +127,8 @@ TEST(XrayPreparation, ExcludesMetalShadowAndReportsItsFractionUnlessSwitchedOff)
   EXPECT_FALSE(mask.isValid(58, 48)) << "dilated";
   EXPECT_TRUE(mask.isValid(20, 48));
   EXPECT_TRUE(mask.isValid(110, 48));
-  const double wireFraction = (4.0 + 2 * 3) / (128.0 - 4);  // wire + 3 px dilation each side, of the field columns
+  // The wire and the 2.7 mm dilation each side (7 px at the assumed 0.4 mm pixels), of the field columns.
+  const double wireFraction = (4.0 + 2 * 7) / (128.0 - 4);
   EXPECT_NEAR(prepared.value().metalFraction, wireFraction, 1e-9);
 
   options.excludeMetal = false;
