@@ -126,9 +126,8 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       !positive(o.maxSagitta_mm) || !positive(o.seedContrastRatio) || !positive(o.denseExcess) ||
       !positive(o.denseContrastRatio) || !positive(o.veryDenseExcess) || !(o.minLength_mm >= 0.0) ||
       !(o.minClippedLength_mm >= 0.0) || !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) ||
-      !std::isfinite(o.growExcess) ||
-      !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) || !(o.dilation_mm >= 0.0) ||
-      !std::isfinite(o.dilation_mm)) {
+      !std::isfinite(o.growExcess) || !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) ||
+      !(o.dilation_mm >= 0.0) || !std::isfinite(o.dilation_mm)) {
     return fail(fmt::format("metal detection options: assumed pixel spacing {} mm, windows ({}, {}, {} mm), "
                             "minimum excess {}, dense and very dense excesses ({}, {}), contrast ratios ({}, {}, {}) "
                             "and sagitta {} mm must be > 0; lengths ({}, {}, {}, {} mm), growth distance {} mm and "
@@ -137,8 +136,7 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
                             o.contrastWindow_mm, o.minExcess, o.denseExcess, o.veryDenseExcess,
                             o.maxContrastRatio, o.seedContrastRatio, o.denseContrastRatio, o.maxSagitta_mm,
                             o.minLength_mm, o.minClippedLength_mm, o.minDenseLength_mm, o.minVeryDenseLength_mm,
-                            o.growDistance_mm,
-                            o.dilation_mm));
+                            o.growDistance_mm, o.dilation_mm));
   }
   const auto toPixels = [spacing_mm](double length_mm) {
     return static_cast<int>(std::lround(length_mm / spacing_mm));
@@ -195,36 +193,40 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
     cv::Mat interior;
     cv::erode(valid != 0, interior, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)), cv::Point(-1, -1), 1,
               cv::BORDER_CONSTANT, cv::Scalar(0));
+    // A set of pixels' length along its longest side, mm.
+    const auto length_mm = [spacing_mm](const std::vector<cv::Point>& pixels) {
+      const cv::RotatedRect box = cv::minAreaRect(pixels);
+      return (std::max(box.size.width, box.size.height) + 1.0) * spacing_mm;
+    };
     cv::Mat seeds = cv::Mat::zeros(rows, cols, CV_8U);
     for (std::size_t label = 1; label < pieces.size(); ++label) {
       const Piece& piece = pieces[label];
       const double count = static_cast<double>(piece.pixels.size());
-      const cv::RotatedRect box = cv::minAreaRect(piece.pixels);
-      const double length_mm = (std::max(box.size.width, box.size.height) + 1.0) * spacing_mm;
+      const double pieceLength_mm = length_mm(piece.pixels);
       const double wide = piece.wideExcessSum / count;
       const double ratio = piece.contrastRatioSum / count;
       // Very dense pieces need no shape test (crossing wires make an X); the others must be straight.
-      const bool veryDense = wide >= o.veryDenseExcess && length_mm >= o.minVeryDenseLength_mm;
+      const bool veryDense = wide >= o.veryDenseExcess && pieceLength_mm >= o.minVeryDenseLength_mm;
       const bool clipped = std::any_of(piece.pixels.begin(), piece.pixels.end(), [&interior](const cv::Point& pixel) {
         return interior.at<std::uint8_t>(pixel) == 0;
       });
       const bool longThin =
-          length_mm >= (clipped ? o.minClippedLength_mm : o.minLength_mm) && ratio < o.seedContrastRatio;
-      const bool dense = wide >= o.denseExcess && length_mm >= o.minDenseLength_mm && ratio < o.denseContrastRatio;
+          pieceLength_mm >= (clipped ? o.minClippedLength_mm : o.minLength_mm) && ratio < o.seedContrastRatio;
+      const bool dense =
+          wide >= o.denseExcess && pieceLength_mm >= o.minDenseLength_mm && ratio < o.denseContrastRatio;
       if (veryDense || ((longThin || dense) && sagitta_px(piece.pixels) * spacing_mm <= o.maxSagitta_mm)) {
         for (const cv::Point& pixel : piece.pixels) seeds.at<std::uint8_t>(pixel) = 1;
         continue;
       }
       // Not straight as a whole: a long straight bar of it with little bone contrast seeds (a wire crossing a screw).
-      if (length_mm < o.minLength_mm) continue;
+      if (pieceLength_mm < o.minLength_mm) continue;
       for (const std::vector<cv::Point>& bar :
            straightBars(piece.pixels, o.minLength_mm / spacing_mm, 0.25 * narrowWindow_px)) {
         if (bar.size() < 3) continue;
-        const cv::RotatedRect barBox = cv::minAreaRect(bar);
         double barRatio = 0.0;
         for (const cv::Point& pixel : bar) barRatio += contrast.at<float>(pixel) / narrowExcess.at<float>(pixel);
         barRatio /= static_cast<double>(bar.size());
-        if ((std::max(barBox.size.width, barBox.size.height) + 1.0) * spacing_mm >= o.minLength_mm &&
+        if (length_mm(bar) >= o.minLength_mm &&
             barRatio < o.seedContrastRatio && sagitta_px(bar) * spacing_mm <= o.maxSagitta_mm) {
           for (const cv::Point& pixel : bar) seeds.at<std::uint8_t>(pixel) = 1;
         }
