@@ -163,6 +163,8 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
     const cv::Mat narrowExcess = image - narrowBackground;
     cv::Mat contrast = narrowBackground - lowSide;
     contrast.setTo(cv::Scalar(0.0f), lowSide == kHigh);
+    // Bone contrast over narrow excess, read at candidate pixels only (their narrow excess is above minExcess > 0).
+    const cv::Mat contrastRatio = contrast / narrowExcess;
 
     const auto minExcess = static_cast<float>(o.minExcess);
     cv::Mat candidates = cv::Mat::zeros(rows, cols, CV_8U);
@@ -187,7 +189,7 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       Piece& piece = pieces[static_cast<std::size_t>(label)];
       piece.pixels.emplace_back(i % cols, i / cols);
       piece.wideExcessSum += wideExcess.ptr<float>()[i];
-      piece.contrastRatioSum += contrast.ptr<float>()[i] / narrowExcess.ptr<float>()[i];
+      piece.contrastRatioSum += contrastRatio.ptr<float>()[i];
     }
     // Pixels next to an invalid pixel or the image's border: a piece reaching them is cut by the field's edge.
     cv::Mat interior;
@@ -221,13 +223,13 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       // Not straight as a whole: a long straight bar of it with little bone contrast seeds (a wire crossing a screw).
       if (pieceLength_mm < o.minLength_mm) continue;
       for (const std::vector<cv::Point>& bar :
-           straightBars(piece.pixels, o.minLength_mm / spacing_mm, 0.25 * narrowWindow_px)) {
+           straightBars(piece.pixels, o.minLength_mm / spacing_mm, 0.25 * narrowWindow_px)) {  // 2.5 mm each side
         if (bar.size() < 3) continue;
         double barRatio = 0.0;
-        for (const cv::Point& pixel : bar) barRatio += contrast.at<float>(pixel) / narrowExcess.at<float>(pixel);
+        for (const cv::Point& pixel : bar) barRatio += contrastRatio.at<float>(pixel);
         barRatio /= static_cast<double>(bar.size());
-        if (length_mm(bar) >= o.minLength_mm &&
-            barRatio < o.seedContrastRatio && sagitta_px(bar) * spacing_mm <= o.maxSagitta_mm) {
+        if (length_mm(bar) >= o.minLength_mm && barRatio < o.seedContrastRatio &&
+            sagitta_px(bar) * spacing_mm <= o.maxSagitta_mm) {
           for (const cv::Point& pixel : bar) seeds.at<std::uint8_t>(pixel) = 1;
         }
       }

@@ -23,9 +23,10 @@
 // - the seeds grow along connected pixels still minExcess above the wide and growExcess above the narrow surroundings
 //   for up to growDistance_mm (the rest of a wire over dense bone, a screw head), and the result is dilated by
 //   dilation_mm (at least 3 px) to cover the blurred edge of the shadow and the glare around it.
-// Not found: objects wider than the wide window, curved or crossing metal that is not very dense, metal
-// that stands less than minExcess above its surroundings (contrast-processed images; thin wires over thick anatomy
-// at coarse pixels).
+// Not found: objects wider than the wide window; curved metal that is not very dense and has no straight bar of
+// minLength_mm; a screw seen end-on whose magnified head is wider than the narrow window and less than veryDenseExcess
+// above its surroundings; metal that stands less than minExcess above its surroundings (contrast-processed images;
+// thin wires over thick anatomy at coarse pixels).
 
 #include <cstddef>
 

@@ -1,6 +1,7 @@
 // MetalMaskDetector: a dark (high line integral) thin bar is masked with its dilation, smooth bone and its edges are
 // not, nor a skull-like rim as dense as the bar, invalid pixels stay invalid and are not counted, a clean image loses
-// nothing, and bad input fails.
+// nothing, a short wire stub is metal only where the field's edge cuts it, a wire crossing a screw is still found, and
+// bad input fails.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,6 +23,17 @@ fct::FloatImage boneImage(float barExcess) {
     }
   }
   return image;
+}
+
+/// Adds `excess` to the pixels of `image` within `halfWidth_px` of the segment a-b (a wire or a screw shaft).
+void addBar(fct::FloatImage& image, double ax, double ay, double bx, double by, double halfWidth_px, float excess) {
+  const double dx = bx - ax, dy = by - ay, lengthSquared = dx * dx + dy * dy;
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) {
+      const double t = std::clamp(((col - ax) * dx + (row - ay) * dy) / lengthSquared, 0.0, 1.0);
+      if (std::hypot(col - ax - t * dx, row - ay - t * dy) <= halfWidth_px) image.at(col, row) += excess;
+    }
+  }
 }
 
 }  // namespace
@@ -118,21 +130,6 @@ TEST(MetalMaskDetector, WindowInMillimetresFollowsThePixelSpacing) {
   EXPECT_TRUE(coarse.value().mask.isValid(111, 60));
   EXPECT_FALSE(fct::MetalMaskDetector().detect(image, field, -1.0).ok());
 }
-
-namespace {
-
-/// Adds `excess` to the pixels of `image` within `halfWidth_px` of the segment a-b (a wire or a screw shaft).
-void addBar(fct::FloatImage& image, double ax, double ay, double bx, double by, double halfWidth_px, float excess) {
-  const double dx = bx - ax, dy = by - ay, lengthSquared = dx * dx + dy * dy;
-  for (int row = 0; row < image.rows; ++row) {
-    for (int col = 0; col < image.cols; ++col) {
-      const double t = std::clamp(((col - ax) * dx + (row - ay) * dy) / lengthSquared, 0.0, 1.0);
-      if (std::hypot(col - ax - t * dx, row - ay - t * dy) <= halfWidth_px) image.at(col, row) += excess;
-    }
-  }
-}
-
-}  // namespace
 
 TEST(MetalMaskDetector, ShortWireStubIsMetalOnlyWhereTheFieldEdgeCutsIt) {
   // At 0.4 mm pixels a thin steel wire (adding 1.8) shows 8 mm of itself where it enters through the bottom edge, and
