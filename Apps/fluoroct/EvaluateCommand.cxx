@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +26,7 @@
 #include "Evaluation/StudyRunner.h"
 #include "Evaluation/StudySetupFile.h"
 #include "Evaluation/StudyShard.h"
+#include "Evaluation/StudyTrialCase.h"
 #include "Evaluation/TrackingFrameStore.h"
 #include "Evaluation/TrackingReport.h"
 #include "Evaluation/TrackingStudy.h"
@@ -53,6 +55,7 @@ struct EvaluateOptions {
   bool oneXraySet = false;  ///< every trial of a CT registers against one X-ray set (StudySetup::xraysPerTrial off)
   std::string shard;               ///< K/N: run only shard K of N; empty: every trial
   std::vector<std::string> merge;  ///< shard output folders to merge into --out instead of running trials
+  std::string writeTrial;          ///< CONDITION:TRIAL: write that trial's case into --out instead of running trials
 };
 
 /// The Transgraph table cache of a run: inside its output folder, so tables are shared by its trials only.
@@ -109,8 +112,9 @@ std::string labelFor(const fs::path& path, const std::vector<StudyCt>& taken) {
 
 /// The CTs of the run: --ct paths; else the phantom (--quick); else those of the data folder $FLUOROCT_DATA_DIR
 /// (pelvis, and the head phantom for table2). Fails, naming both ways to give the CTs, when neither --ct nor
-/// FLUOROCT_DATA_DIR is given or the folder lacks a CT; fails on a CT that cannot be read.
-Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o) {
+/// FLUOROCT_DATA_DIR is given or the folder lacks a CT; fails on a CT that cannot be read. `sources`, when given, gets
+/// the path each CT was read from (empty for the phantom).
+Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, std::vector<fs::path>* sources = nullptr) {
   std::vector<StudyCt> cts;
   std::vector<std::pair<std::string, fs::path>> paths;
   for (const std::string& p : o.cts) paths.emplace_back("", p);
@@ -121,6 +125,7 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o) {
     auto volume = PhantomBuilder::build(phantom);
     if (!volume) return fail(volume.error());
     cts.push_back(StudyCt{"phantom", std::move(volume).value()});
+    if (sources) sources->push_back({});
     return cts;
   }
   if (paths.empty()) {
@@ -151,6 +156,7 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o) {
     }
     printWarnings(volume.warnings());
     cts.push_back(StudyCt{label.empty() ? labelFor(path, cts) : label, std::move(volume).value()});
+    if (sources) sources->push_back(path);
   }
   return cts;
 }
@@ -183,6 +189,7 @@ Status prepareOutput(const fs::path& out) {
 struct PreparedStudy {
   StudyDefinition study;
   std::vector<StudyCt> cts;
+  std::vector<fs::path> ctSources;  ///< the path each CT was read from (empty: the phantom)
   std::optional<StudyShard> shard;
   std::string setup;
 };
@@ -205,8 +212,9 @@ Result<StudyDefinition> checkOptions(const EvaluateOptions& o) {
 /// Loads the CTs of the checked study `known` and defines it over them. For a run, checks (or writes) DIR/setup.txt
 /// against the trials in `store`; a merge checks its folders later (StudyMerge). Fails with the message to report.
 Result<PreparedStudy> prepareStudy(const EvaluateOptions& o, const StudyDefinition& known, const TrialStore* store) {
+  PreparedStudy prepared;
   // The CTs are found before setup.txt is written, so that a run without them leaves no setup behind.
-  auto cts = loadCts(o);
+  auto cts = loadCts(o, &prepared.ctSources);
   if (!cts) return fail(cts.error());
   std::vector<std::string> labels;
   for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
@@ -216,7 +224,6 @@ Result<PreparedStudy> prepareStudy(const EvaluateOptions& o, const StudyDefiniti
   for (StudyCondition& c : study.value().conditions) {
     if (o.trials > 0) c.trials = std::min(c.trials, o.trials);
   }
-  PreparedStudy prepared;
   // The shard deals out the trials of the run (after --trials); checked by checkOptions.
   if (!o.shard.empty()) prepared.shard = StudyShard::parse(study.value(), o.shard).value();
   prepared.setup = StudySetupFile::text(known, o.cts, prepared.shard ? &*prepared.shard : nullptr);
@@ -359,11 +366,52 @@ int runTrackingStudy(const EvaluateOptions& o) {
   return 0;
 }
 
+/// --write-trial CONDITION:TRIAL: writes that trial's case into --out (StudyTrialCase) and prints the command that
+/// registers it as the study does.
+int runWriteTrial(const EvaluateOptions& o, const StudyDefinition& known) {
+  const std::size_t colon = o.writeTrial.rfind(':');
+  int trial = -1;
+  const char* digits = colon == std::string::npos ? nullptr : o.writeTrial.c_str() + colon + 1;
+  const char* end = o.writeTrial.c_str() + o.writeTrial.size();
+  if (!digits || digits == end || std::from_chars(digits, end, trial).ptr != end) {
+    return reportError(fmt::format("--write-trial must be CONDITION:TRIAL, e.g. pelvis/realistic:1 (a condition of "
+                                   "the study's report and a 0-based trial), got '{}'",
+                                   o.writeTrial));
+  }
+  auto prepared = prepareStudy(o, known, nullptr);
+  if (!prepared) return reportError(prepared.error());
+  const PreparedStudy& p = prepared.value();
+  const std::string condition = o.writeTrial.substr(0, colon);
+  const auto named = std::find_if(p.study.conditions.begin(), p.study.conditions.end(),
+                                  [&](const StudyCondition& c) { return c.name == condition; });
+  fs::path ctSource;
+  if (named != p.study.conditions.end()) {
+    for (std::size_t i = 0; i < p.cts.size(); ++i) {
+      if (p.cts[i].label == named->ct) ctSource = p.ctSources[i];
+    }
+  }
+  auto files = StudyTrialCase::write(p.study, p.cts, condition, trial, ctSource, o.out);
+  if (!files) return reportError("--write-trial: " + files.error());
+  const StudyTrialCaseFiles& f = files.value();
+  fmt::print("wrote trial {} of {} (start {:.2f} mm mean sTRE from the truth) into {}; register it as the study does:\n"
+             "  fluoroct register --ct {} --views {} --init {} --truth {} --preset {} --cut-face-margin-mm {:g} "
+             "--seed {} --out RESULT_DIR\n",
+             trial, condition, f.initialStre_mm, o.out, f.registrationCt.string(), f.viewFile.string(),
+             f.startFile.string(), f.truthFile.string(), p.study.setup.preset, f.cutFaceMargin_mm,
+             p.study.setup.seed + static_cast<std::uint32_t>(trial));
+  return 0;
+}
+
 int runEvaluate(const EvaluateOptions& o) {
-  if (o.study == "tracking") return runTrackingStudy(o);
+  if (o.study == "tracking") {
+    if (!o.writeTrial.empty()) return reportError("--write-trial applies to table2, capture, ablation and views");
+    return runTrackingStudy(o);
+  }
   auto known = checkOptions(o);
   if (!known) return reportError(known.error());
+  if (!o.merge.empty() && !o.writeTrial.empty()) return reportError("--write-trial and --merge exclude each other");
   if (!o.merge.empty()) return runMerge(o, known.value());
+  if (!o.writeTrial.empty()) return runWriteTrial(o, known.value());
   if (Status ready = prepareOutput(o.out); !ready) return reportError(ready.error());
   auto store = TrialStore::open(fs::path(o.out) / "trials.csv");
   if (!store) return reportError("--out: " + store.error());
@@ -453,6 +501,11 @@ void registerEvaluateCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--merge", options->merge,
                       "Merge these shard folders (of one study run with --shard K/N, all K, and the same options as "
                       "given here) into --out instead of running trials")
+      ->excludes(shard);
+  command->add_option("--write-trial", options->writeTrial,
+                      "Write one trial as a case folder into --out instead of running trials: CONDITION:TRIAL, e.g. "
+                      "pelvis/realistic:1 (the trial's X-rays as 16-bit PNG, views.json, truth_pose.json, "
+                      "start_pose.json and, for coarser slices, ct_registration.nrrd); prints the register command")
       ->excludes(shard);
   command->callback([&action, options] { action = [options] { return runEvaluate(*options); }; });
 }

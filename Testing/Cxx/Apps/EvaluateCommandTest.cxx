@@ -322,3 +322,54 @@ TEST(EvaluateCommand, FullStudyTakesItsCtFromTheDataFolderNamedByTheEnvironment)
   ASSERT_EQ(store.value().records().size(), 5u);  // 1 to 5 views, one trial each
   for (const fct::TrialRecord& r : store.value().records()) EXPECT_EQ(r.ct, "pelvis") << r.condition;
 }
+
+TEST(EvaluateCommand, WriteTrialWritesACaseThatTheRegisterCommandItPrintsRuns) {
+  const auto dir = fct::test::scratchDir();
+  const auto written = fct::test::runCli(
+      fmt::format("evaluate --study table2 --quick --write-trial phantom/ideal:1 --out '{}'", (dir / "case").string()));
+  ASSERT_EQ(written.exitCode, 0) << written.err;
+  // The phantom is built in memory, so its CT is written too.
+  for (const char* file : {"views.json", "truth_pose.json", "start_pose.json", "ct_registration.nrrd", "ap.png"}) {
+    EXPECT_TRUE(fs::exists(dir / "case" / file)) << file;
+  }
+  EXPECT_FALSE(fs::exists(dir / "case" / "trials.csv")) << "no trial is run";
+  const std::size_t at = written.out.find("  fluoroct register ");
+  ASSERT_NE(at, std::string::npos) << written.out;
+  std::string registerCommand = written.out.substr(at + 11);
+  registerCommand = registerCommand.substr(0, registerCommand.find('\n'));
+  EXPECT_NE(registerCommand.find("--preset fast --cut-face-margin-mm 5 --seed 2"), std::string::npos)
+      << registerCommand;
+  registerCommand.replace(registerCommand.find("RESULT_DIR"), 10, "'" + (dir / "result").string() + "'");
+  const auto registered = fct::test::runCli(registerCommand);
+  ASSERT_EQ(registered.exitCode, 0) << registered.err;
+  // The start the case holds is the one the write reported: the same mean sTRE from the truth (on the same CT: the
+  // ideal scenario registers on the study's CT).
+  const std::size_t start = written.out.find("(start ");
+  ASSERT_NE(start, std::string::npos) << written.out;
+  const std::string startStre = written.out.substr(start + 7, written.out.find(" mm", start) - start - 7);
+  EXPECT_NE(registered.out.find("mean bone-surface distance " + startStre), std::string::npos)
+      << startStre << "\n" << registered.out;
+}
+
+TEST(EvaluateCommand, WriteTrialRefusesABadTrialNameWithOneErrorLine) {
+  const auto dir = fct::test::scratchDir();
+  const auto run = [&](const std::string& trial) {
+    return fct::test::runCli(
+        fmt::format("evaluate --study table2 --quick --write-trial '{}' --out '{}'", trial, (dir / "o").string()));
+  };
+  const auto noTrial = run("phantom/realistic");
+  EXPECT_EQ(noTrial.exitCode, 2);
+  EXPECT_EQ(noTrial.err.rfind("error: --write-trial must be CONDITION:TRIAL", 0), 0u) << noTrial.err;
+  const auto unknown = run("pelvis/realistic:0");
+  EXPECT_EQ(unknown.exitCode, 2);
+  EXPECT_EQ(unknown.err.rfind("error: --write-trial: study 'table2' has no condition 'pelvis/realistic'; its conditions "
+                              "are: phantom/ideal",
+                              0),
+            0u)
+      << unknown.err;
+  EXPECT_EQ(std::count(unknown.err.begin(), unknown.err.end(), '\n'), 1) << unknown.err;
+  const auto outside = run("phantom/bad:2");
+  EXPECT_EQ(outside.exitCode, 2);
+  EXPECT_NE(outside.err.find("condition 'phantom/bad' has trials 0 to 1, not 2"), std::string::npos) << outside.err;
+  EXPECT_FALSE(fs::exists(dir / "o"));
+}
