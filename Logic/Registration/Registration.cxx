@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "Geometry/RigidPose.h"
+#include "Registration/ProjectionShiftAligner.h"
 #include "Registration/RegistrationObjective.h"
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
@@ -167,17 +168,52 @@ Status applySearchOutcome(const Result<OptimizationResult>& found, const Progres
   return Ok{};
 }
 
+/// Rounds of shift pre-alignment at most.
+constexpr int kShiftPrealignRounds = 3;
+
+/// Shift pre-alignment of a stage (ProjectionShiftAligner at its level, repeated): moves `current` by each alignment
+/// that raises the stage's similarity (`objective`) and returns the translation added in all (LPS mm; zero when the
+/// first did not). Fails, naming the stage, on a rendering error.
+Result<Eigen::Vector3d> prealignByShift(RegistrationCase& registrationCase, const RegistrationStage& stage,
+                                        RegistrationObjective& objective, PoseVector& current) {
+  const auto failed = [&](const std::string& error) { return fail(fmt::format("stage '{}': {}", stage.name, error)); };
+  Eigen::Isometry3d T_current = registrationCase.poseTransform(current);
+  auto similarity = objective.similarity(T_current);
+  if (!similarity) return failed(similarity.error());
+  Eigen::Vector3d total_world_mm = Eigen::Vector3d::Zero();
+  // A far start's DRR overlaps its X-ray only in part, so one alignment may bring it only part of the way: repeat
+  // while the similarity rises and the move is more than a millimetre.
+  for (int round = 0; round < kShiftPrealignRounds; ++round) {
+    auto aligned = ProjectionShiftAligner::align(registrationCase, T_current, stage.level);
+    if (!aligned) return failed(aligned.error());
+    if (aligned.value().translation_world_mm.norm() < 1.0) break;
+    auto after = objective.similarity(aligned.value().T_world_from_ct);
+    if (!after) return failed(after.error());
+    if (!(after.value() > similarity.value())) break;
+    auto moved = RigidPose::fromTransform(aligned.value().T_world_from_ct, registrationCase.rotationCentre_ct_mm());
+    if (!moved) return failed(moved.error());
+    current = moved.value().asVector();
+    T_current = aligned.value().T_world_from_ct;
+    similarity = after;
+    total_world_mm += aligned.value().translation_world_mm;
+  }
+  return total_world_mm;
+}
+
 /// Runs stage `stageIndex` from `current` (pose parameters, deg and mm), moving `current` to the stage's best pose;
-/// `drrsBefore` counts the earlier stages' DRRs for the progress reports. Returns the stage's report; fails, naming
+/// `drrsBefore` counts the earlier stages' DRRs for the progress reports; `prealignShift_world_mm` is the move of the
+/// stage's shift pre-alignment, for the report. Returns the stage's report; fails, naming
 /// the stage, on a rendering or search error.
 Result<StageReport> runStage(const StageContext& context, int stageIndex, const RegistrationStage& stage,
-                             RegistrationObjective& objective, long drrsBefore, PoseVector& current) {
+                             RegistrationObjective& objective, long drrsBefore,
+                             const Eigen::Vector3d& prealignShift_world_mm, PoseVector& current) {
   const auto stageStart = Clock::now();
   const std::clock_t stageCpuStart = std::clock();
   RegistrationCase& registrationCase = context.registrationCase;
   auto startValue = objective.similarity(registrationCase.poseTransform(current));
   if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
   StageReport report = startReport(stage, startValue.value(), objective);
+  report.prealignShift_world_mm = prealignShift_world_mm;
 
   RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startValue.value());
   std::string renderError;
@@ -247,7 +283,25 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       break;
     }
     const auto i = static_cast<std::size_t>(s);
-    auto report = runStage(context, s, schedule.stages[i], objectives.value()[i], result.totalDrrs, current);
+    const RegistrationStage& stage = schedule.stages[i];
+    Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();
+    if (stage.shiftPrealign) {
+      auto shift = prealignByShift(registrationCase, stage, objectives.value()[i], current);
+      if (!shift) return fail(shift.error());
+      prealignShift_world_mm = shift.value();
+    }
+    // Every later stage, and a stage whose start the pre-alignment moved, makes its pixel sets (cut-face masks) and
+    // coarse CT at its own start pose: the pose the search begins from, not the run's initial pose.
+    if (s > 0 || !prealignShift_world_mm.isZero()) {
+      const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
+      auto rebuilt = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
+                                                   options.ablation.noCtPyramid ? std::nullopt
+                                                                                : std::optional(T_stageStart),
+                                                   std::optional(T_stageStart));
+      if (!rebuilt) return fail(rebuilt.error());
+      objectives.value()[i] = std::move(rebuilt).value();
+    }
+    auto report = runStage(context, s, stage, objectives.value()[i], result.totalDrrs, prealignShift_world_mm, current);
     if (!report) return fail(report.error());
     result.totalDrrs += report.value().drrs;
     result.stages.push_back(std::move(report).value());

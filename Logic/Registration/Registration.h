@@ -61,6 +61,9 @@ struct StageReport {
   double startSimilarity = 0.0;    ///< at the stage's start pose
   double similarity = 0.0;         ///< at the stage's final pose (>= startSimilarity)
   std::vector<double> keptFraction;  ///< per view: compared pixels / valid pixels at the stage's level
+  /// The translation its shift pre-alignment added to the stage's start (LPS mm); zero without one, or when the moved
+  /// start did not raise the similarity (then the start is kept).
+  Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();
   bool cancelled = false;
   Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the stage's final pose (LPS mm)
 };

@@ -104,6 +104,7 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
     }
     stage.keptFraction.push_back(value->get<double>());
   }
+  if (reader.has("prealign_shift_mm")) stage.prealignShift_world_mm = reader.vector("prealign_shift_mm", 3);
   stage.cancelled = reader.boolean("cancelled");
   parent.adoptError(reader);
   return stage;
@@ -130,6 +131,9 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
                       {"similarity", s.similarity},
                       {"kept_fraction", std::move(kept)},
                       {"cancelled", s.cancelled}});
+    if (!s.prealignShift_world_mm.isZero()) {
+      stages.back()["prealign_shift_mm"] = JsonDocument::array(s.prealignShift_world_mm);
+    }
   }
   ordered_json initialPose = ordered_json::object();
   initialPose["T_world_from_ct"] = JsonDocument::array(result.T_initial.matrix());

@@ -61,6 +61,17 @@ void readCmaEs(const nlohmann::json& object, const std::string& where, JsonReade
   parent.adoptError(reader);
 }
 
+/// Reads the optional boolean `key` into `flag`; rejects any other type.
+void optionalFlag(JsonReader& reader, const char* key, bool& flag) {
+  const nlohmann::json* value = reader.find(key);
+  if (!value) return;
+  if (value->is_boolean()) {
+    flag = value->get<bool>();
+  } else {
+    reader.rejectKey(key, fmt::format("is {}; use true or false", JsonReader::describe(*value)));
+  }
+}
+
 Result<RegistrationStage> readStage(const nlohmann::json& object, const std::string& where) {
   RegistrationStage stage;
   JsonReader reader(object, where);
@@ -68,13 +79,8 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   stage.metric = parseName(reader, "metric", kMetrics);
   stage.level = reader.integer("level", 0);
   if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
-  if (const nlohmann::json* exact = reader.find("exact_drr")) {
-    if (exact->is_boolean()) {
-      stage.exactDrr = exact->get<bool>();
-    } else {
-      reader.rejectKey("exact_drr", fmt::format("is {}; use true or false", JsonReader::describe(*exact)));
-    }
-  }
+  optionalFlag(reader, "exact_drr", stage.exactDrr);
+  optionalFlag(reader, "shift_prealign", stage.shiftPrealign);
   if (reader.has("drr")) stage.drrMethod = parseName(reader, "drr", kStageDrrMethods);
   optionalNumber(reader, "drr_step_voxels", stage.drrStep_voxels);
   if (reader.ok() && reader.has("drr_step_voxels")) {
@@ -253,6 +259,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
                                      {"exact_drr", s.exactDrr}};
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
+    if (s.shiftPrealign) stageJson["shift_prealign"] = true;
     stageJson["pixels"] = std::move(pixels);
     stageJson["search"] = std::move(search);
     stagesJson.push_back(std::move(stageJson));

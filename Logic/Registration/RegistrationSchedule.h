@@ -58,6 +58,10 @@ struct RegistrationStage {
   /// With drrMethod raycast: the sampling step in voxels (one voxel: the cube root of the voxel volume); 0: the
   /// renderer's default, half the smallest spacing.
   double drrStep_voxels = 0.0;
+  /// Before the search, move the start by the translation that lines up each view's DRR with its X-ray in 2D at the
+  /// stage's level (ProjectionShiftAligner), when that raises the stage's similarity: a far start's DRR then overlaps
+  /// its X-ray before the search looks around it.
+  bool shiftPrealign = false;
   PixelSetSpec pixels;
   SearchStrategy search = SearchStrategy::Local;
   int maxEvaluations = 1000;       ///< cap on DRR sets (one per view) of the stage's search

@@ -38,7 +38,9 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
   EXPECT_EQ(s[0].metric, fct::SimilarityMetric::Ncc);
   EXPECT_EQ(s[0].search, fct::SearchStrategy::Genetic);
   EXPECT_GT(s[0].pixels.maxPixels, 0) << "the global stage samples its level sparsely";
+  EXPECT_TRUE(s[0].shiftPrealign) << "a far start is first lined up in 2D";
   for (std::size_t i = 1; i < s.size(); ++i) {
+    EXPECT_FALSE(s[i].shiftPrealign);
     EXPECT_EQ(s[i].metric, fct::SimilarityMetric::Vlnc);
     EXPECT_EQ(s[i].pixels.kind, fct::PixelSetKind::Rois);
   }
@@ -110,6 +112,8 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
        "exact_drr"},
       {stageHead + R"("metric": "ncc", "level": 0, "drr": "transgraph", "pixels": {"set": "whole"}, )" + search + "]}",
        "drr"},
+      {stageHead + R"("metric": "ncc", "level": 2, "shift_prealign": 1, "pixels": {"set": "whole"}, )" + search + "]}",
+       "shift_prealign"},
       {stageHead + R"("metric": "ncc", "level": 0, "drr_step_voxels": 1, "pixels": {"set": "whole"}, )" + search + "]}",
        "drr_step_voxels"},
       {stageHead + R"("metric": "ncc", "level": 0, "drr": "raycast", "drr_step_voxels": 0, "pixels": {"set": "whole"}, )" +

@@ -410,3 +410,21 @@ TEST(Registration, WithoutTheCtPyramidTheSameStartConvergesAsWell) {
   EXPECT_NE(pyramid.value().T_world_from_ct.matrix(), fullCt.value().T_world_from_ct.matrix())
       << "the switch changes the coarse levels' DRRs";
 }
+
+TEST(Registration, ShiftPrealignmentMovesAFarStartOnceAndTheRunEndsAtTheTruth) {
+  Prepared p = preparePhantom();
+  const fct::RegistrationOptions options = fastOptions(3, fct::RegistrationSchedule::kDefaultPreset);
+  ASSERT_TRUE(options.schedule.stages.front().shiftPrealign);
+  for (const Eigen::Vector3d& offset_mm : {Eigen::Vector3d(60.0, -55.0, 50.0), Eigen::Vector3d(-70.0, 40.0, -55.0)}) {
+    const Eigen::Isometry3d start = Eigen::Translation3d(offset_mm) * p.simulated.T_truth;
+    auto result = fct::Registration::run(p.registrationCase, start, options);
+    ASSERT_TRUE(result.ok()) << result.error();
+    const auto& stages = result.value().stages;
+    EXPECT_LT((stages.front().prealignShift_world_mm + offset_mm).norm(), 0.2 * offset_mm.norm())
+        << "moved by " << stages.front().prealignShift_world_mm.transpose();
+    for (std::size_t s = 1; s < stages.size(); ++s) {
+      EXPECT_TRUE(stages[s].prealignShift_world_mm.isZero()) << "only the first stage pre-aligns";
+    }
+    EXPECT_LT(errorOf(p, result.value().T_world_from_ct), 0.5);
+  }
+}

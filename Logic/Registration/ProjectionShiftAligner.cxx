@@ -1,0 +1,158 @@
+#include "Registration/ProjectionShiftAligner.h"
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace fct {
+
+namespace {
+
+/// A DRR's best 2D shift against an X-ray of the same level: (col, row) in that level's pixels and its correlation.
+struct LevelShift {
+  Eigen::Vector2d shift_px = Eigen::Vector2d::Zero();
+  double correlation = 0.0;
+};
+
+/// The offset of a parabola's vertex through (-1, a), (0, b), (1, c) from 0, within [-0.5, 0.5].
+double parabolaPeak(double a, double b, double c) {
+  const double curvature = a - 2.0 * b + c;
+  if (!(curvature < 0.0)) return 0.0;
+  return std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
+}
+
+/// The shift of `drr` (its footprint: the bounding box of the pixels above 5 % of its largest value) that correlates
+/// best with `xray` over its valid pixels, searched up to maxShiftFraction of the image per axis; nullopt when the DRR
+/// or the X-ray's valid pixels are empty or constant.
+std::optional<LevelShift> bestShift(const FloatImage& drr, const FloatImage& xray, const ValidMask& mask,
+                                    double maxShiftFraction) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < xray.pixels.size(); ++i) {
+    if (mask.valid[i]) {
+      sum += xray.pixels[i];
+      ++count;
+    }
+  }
+  if (count == 0) return std::nullopt;
+  const auto mean = static_cast<float>(sum / static_cast<double>(count));
+  cv::Mat image(xray.rows, xray.cols, CV_32F);
+  for (int r = 0; r < xray.rows; ++r) {
+    for (int c = 0; c < xray.cols; ++c) image.at<float>(r, c) = mask.isValid(c, r) ? xray.at(c, r) : mean;
+  }
+  const float largest = *std::max_element(drr.pixels.begin(), drr.pixels.end());
+  if (!(largest > 0.0f)) return std::nullopt;
+  int c0 = drr.cols, c1 = -1, r0 = drr.rows, r1 = -1;
+  for (int r = 0; r < drr.rows; ++r) {
+    for (int c = 0; c < drr.cols; ++c) {
+      if (drr.at(c, r) > 0.05f * largest) {
+        c0 = std::min(c0, c);
+        c1 = std::max(c1, c);
+        r0 = std::min(r0, r);
+        r1 = std::max(r1, r);
+      }
+    }
+  }
+  if (c1 - c0 < 2 || r1 - r0 < 2) return std::nullopt;
+  const cv::Rect box(c0, r0, c1 - c0 + 1, r1 - r0 + 1);
+  const cv::Mat drrMat(drr.rows, drr.cols, CV_32F, const_cast<float*>(drr.pixels.data()));
+  const cv::Mat templ = drrMat(box).clone();
+  const int padCols = static_cast<int>(std::ceil(maxShiftFraction * xray.cols));
+  const int padRows = static_cast<int>(std::ceil(maxShiftFraction * xray.rows));
+  cv::Mat padded;
+  cv::copyMakeBorder(image, padded, padRows, padRows, padCols, padCols, cv::BORDER_CONSTANT, cv::Scalar(mean));
+  cv::Mat correlation;
+  cv::matchTemplate(padded, templ, correlation, cv::TM_CCOEFF_NORMED);
+  // Template position (top-left in `padded`) of zero shift, and the positions within the shift range.
+  const int zeroCol = box.x + padCols, zeroRow = box.y + padRows;
+  const cv::Rect range = cv::Rect(zeroCol - padCols, zeroRow - padRows, 2 * padCols + 1, 2 * padRows + 1) &
+                         cv::Rect(0, 0, correlation.cols, correlation.rows);
+  if (range.empty()) return std::nullopt;
+  double peak = 0.0;
+  cv::Point at;
+  cv::minMaxLoc(correlation(range), nullptr, &peak, nullptr, &at);
+  if (!std::isfinite(peak)) return std::nullopt;
+  // A peak on the border of the range is a cut-off slope, not a match.
+  if (at.x == 0 || at.y == 0 || at.x == range.width - 1 || at.y == range.height - 1) return std::nullopt;
+  at += range.tl();
+  LevelShift shift;
+  shift.correlation = peak;
+  shift.shift_px = Eigen::Vector2d(at.x - zeroCol, at.y - zeroRow);
+  const auto value = [&](int r, int c) { return static_cast<double>(correlation.at<float>(r, c)); };
+  if (at.x > 0 && at.x + 1 < correlation.cols) {
+    shift.shift_px.x() += parabolaPeak(value(at.y, at.x - 1), peak, value(at.y, at.x + 1));
+  }
+  if (at.y > 0 && at.y + 1 < correlation.rows) {
+    shift.shift_px.y() += parabolaPeak(value(at.y - 1, at.x), peak, value(at.y + 1, at.x));
+  }
+  return shift;
+}
+
+/// The translation t (world mm) for which each camera projects centre + t nearest its target (full-resolution px):
+/// damped Gauss-Newton from 0, the damping keeping the part of t that the views do not see (one view's depth) small.
+Eigen::Vector3d triangulateTranslation(const std::vector<Camera>& cameras, const std::vector<Eigen::Vector2d>& targets,
+                                       const Eigen::Vector3d& centre_world_mm) {
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  constexpr double kStep_mm = 0.5;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+    for (std::size_t v = 0; v < cameras.size(); ++v) {
+      const Eigen::Vector2d at = cameras[v].project(centre_world_mm + t);
+      Eigen::Matrix<double, 2, 3> jacobian;
+      for (int a = 0; a < 3; ++a) {
+        jacobian.col(a) = (cameras[v].project(centre_world_mm + t + kStep_mm * Eigen::Vector3d::Unit(a)) - at) / kStep_mm;
+      }
+      normal += jacobian.transpose() * jacobian;
+      gradient += jacobian.transpose() * (targets[v] - at);
+    }
+    const double damping = 1e-3 * normal.trace() / 3.0 + 1e-12;
+    const Eigen::Vector3d step = (normal + damping * Eigen::Matrix3d::Identity()).ldlt().solve(gradient);
+    if (!step.allFinite()) break;
+    t += step;
+    if (step.norm() < 0.01) break;
+  }
+  return t;
+}
+
+}  // namespace
+
+Result<ShiftAlignment> ProjectionShiftAligner::align(RegistrationCase& registrationCase,
+                                                     const Eigen::Isometry3d& T_world_from_ct, int level,
+                                                     double maxShiftFraction, double minPeakCorrelation) {
+  if (level < 0 || level >= registrationCase.levelCount()) {
+    return fail(fmt::format("shift alignment level {} is not one of the pyramid's levels 0 to {}", level,
+                            registrationCase.levelCount() - 1));
+  }
+  if (!(maxShiftFraction > 0.0 && maxShiftFraction <= 1.0)) {
+    return fail(fmt::format("shift alignment range must be a fraction of the image in (0, 1], got {}", maxShiftFraction));
+  }
+  ShiftAlignment out;
+  out.T_world_from_ct = T_world_from_ct;
+  const Eigen::Vector3d centre_world_mm = T_world_from_ct * registrationCase.rotationCentre_ct_mm();
+  const double levelScale = std::ldexp(1.0, level);
+  std::vector<Camera> cameras;
+  std::vector<Eigen::Vector2d> targets;
+  for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
+    const PyramidLevel& xray = registrationCase.prepared(v).pyramid.level(level);
+    auto renderer = registrationCase.levelRenderer(v, level, T_world_from_ct);
+    if (!renderer) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), renderer.error()));
+    auto drr = renderer.value()->render(registrationCase.camera(v), T_world_from_ct, level);
+    if (!drr) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), drr.error()));
+    const std::optional<LevelShift> shift = bestShift(drr.value(), xray.image, xray.mask, maxShiftFraction);
+    out.shift_px.push_back(shift ? Eigen::Vector2d(levelScale * shift->shift_px) : Eigen::Vector2d::Zero());
+    out.peakCorrelation.push_back(shift ? shift->correlation : 0.0);
+    if (!shift || shift->correlation < minPeakCorrelation) continue;
+    cameras.push_back(registrationCase.camera(v));
+    targets.push_back(registrationCase.camera(v).project(centre_world_mm) + out.shift_px.back());
+  }
+  if (cameras.empty()) return out;
+  out.translation_world_mm = triangulateTranslation(cameras, targets, centre_world_mm);
+  out.T_world_from_ct = Eigen::Translation3d(out.translation_world_mm) * T_world_from_ct;
+  return out;
+}
+
+}  // namespace fct
