@@ -289,10 +289,14 @@ QString RegisterStepWidget::plainStageName(const std::string& stage) {
 void RegisterStepWidget::logStages(const RegistrationResult& result) {
   for (const StageReport& stage : result.stages) {
     appendLog(QString::fromStdString(fmt::format(
-                  "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}",
+                  "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}{}",
                   plainStageName(stage.name).toStdString(), RegistrationSchedule::metricName(stage.metric), stage.level,
                   RegistrationSchedule::searchName(stage.search), stage.evaluations, stage.drrs, stage.startSimilarity,
-                  stage.similarity, stage.seconds, stage.cancelled ? " (cancelled)" : "")));
+                  stage.similarity, stage.seconds,
+                  stage.prealignShift_world_mm.isZero()
+                      ? ""
+                      : fmt::format(", start moved {:.1f} mm by shift pre-alignment", stage.prealignShift_world_mm.norm()),
+                  stage.cancelled ? " (cancelled)" : "")));
   }
 }
 
