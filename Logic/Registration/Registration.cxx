@@ -168,6 +168,19 @@ Status applySearchOutcome(const Result<OptimizationResult>& found, const Progres
   return Ok{};
 }
 
+/// A stage rebuilds its objective at its start pose when that pose moved the bone more than this from the run's initial
+/// pose (boneMotionBound_mm): the cut-face margin of the studies, within which a mask made at the initial pose holds.
+constexpr double kObjectiveRebuildDistance_mm = 5.0;
+
+/// A bound on how far the bone surface moves between two poses, mm: the bone centre's displacement plus the bone
+/// radius times the rotation angle between them.
+double boneMotionBound_mm(const RegistrationCase& registrationCase, const Eigen::Isometry3d& T_a,
+                          const Eigen::Isometry3d& T_b) {
+  const Eigen::Vector3d centre_ct_mm = registrationCase.rotationCentre_ct_mm();
+  const double angle_rad = Eigen::AngleAxisd(T_b.linear() * T_a.linear().transpose()).angle();
+  return (T_b * centre_ct_mm - T_a * centre_ct_mm).norm() + registrationCase.boneRadius_mm() * angle_rad;
+}
+
 /// Rounds of shift pre-alignment at most.
 constexpr int kShiftPrealignRounds = 3;
 
@@ -290,10 +303,10 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       if (!shift) return fail(shift.error());
       prealignShift_world_mm = shift.value();
     }
-    // Every later stage, and a stage whose start the pre-alignment moved, makes its pixel sets (cut-face masks) and
-    // coarse CT at its own start pose: the pose the search begins from, not the run's initial pose.
-    if (s > 0 || !prealignShift_world_mm.isZero()) {
-      const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
+    // A stage whose start lies far from the run's initial pose (after a far start's first stage, or its shift
+    // pre-alignment) makes its pixel sets (cut-face masks) and coarse CT again at its own start pose.
+    const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
+    if (boneMotionBound_mm(registrationCase, T_initial, T_stageStart) > kObjectiveRebuildDistance_mm) {
       auto rebuilt = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
                                                    options.ablation.noCtPyramid ? std::nullopt
                                                                                 : std::optional(T_stageStart),
