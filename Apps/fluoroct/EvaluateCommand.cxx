@@ -93,7 +93,7 @@ fs::path dataDir() {
 }
 
 /// A label for a CT path: its file or folder name without image extensions, unique among `taken`.
-std::string labelFor(const fs::path& path, const std::vector<StudyCt>& taken) {
+std::string labelFor(const fs::path& path, const std::vector<std::string>& taken) {
   std::string name = path.filename().string();
   if (name.empty()) name = path.parent_path().filename().string();
   for (const char* ext : {".nii.gz", ".nii", ".nrrd", ".nhdr", ".mha", ".mhd"}) {
@@ -104,7 +104,7 @@ std::string labelFor(const fs::path& path, const std::vector<StudyCt>& taken) {
     }
   }
   std::string label = name;
-  for (int n = 2; std::any_of(taken.begin(), taken.end(), [&](const StudyCt& c) { return c.label == label; }); ++n) {
+  for (int n = 2; std::find(taken.begin(), taken.end(), label) != taken.end(); ++n) {
     label = fmt::format("{}-{}", name, n);
   }
   return label;
@@ -113,8 +113,10 @@ std::string labelFor(const fs::path& path, const std::vector<StudyCt>& taken) {
 /// The CTs of the run: --ct paths; else the phantom (--quick); else those of the data folder $FLUOROCT_DATA_DIR
 /// (pelvis, and the head phantom for table2). Fails, naming both ways to give the CTs, when neither --ct nor
 /// FLUOROCT_DATA_DIR is given or the folder lacks a CT; fails on a CT that cannot be read. `sources`, when given, gets
-/// the path each CT was read from (empty for the phantom).
-Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, std::vector<fs::path>* sources = nullptr) {
+/// the path each CT was read from (empty for the phantom). With `onlyLabel` naming one of the CTs, only that one is
+/// loaded.
+Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, std::vector<fs::path>* sources = nullptr,
+                                     const std::string& onlyLabel = {}) {
   std::vector<StudyCt> cts;
   std::vector<std::pair<std::string, fs::path>> paths;
   for (const std::string& p : o.cts) paths.emplace_back("", p);
@@ -146,16 +148,24 @@ Result<std::vector<StudyCt>> loadCts(const EvaluateOptions& o, std::vector<fs::p
       }
     }
   }
+  // A CT of --ct is labelled by its file name; the others come from the data folder.
+  const bool fromCtOption = !o.cts.empty();
+  std::vector<std::string> labels;
+  for (auto& [label, path] : paths) {
+    if (label.empty()) label = labelFor(path, labels);
+    labels.push_back(label);
+  }
+  const bool onlyOne = std::find(labels.begin(), labels.end(), onlyLabel) != labels.end();
   for (const auto& [label, path] : paths) {
+    if (onlyOne && label != onlyLabel) continue;
     fmt::print(stderr, "evaluate: loading CT {}\n", path.string());
     auto volume = CtLoader::load(path);
     if (!volume) {
-      // A CT of --ct has no label yet; the others come from the data folder.
-      return fail(fmt::format("{} {}: {}", label.empty() ? "--ct" : "FLUOROCT_DATA_DIR CT", path.string(),
+      return fail(fmt::format("{} {}: {}", fromCtOption ? "--ct" : "FLUOROCT_DATA_DIR CT", path.string(),
                               volume.error()));
     }
     printWarnings(volume.warnings());
-    cts.push_back(StudyCt{label.empty() ? labelFor(path, cts) : label, std::move(volume).value()});
+    cts.push_back(StudyCt{label, std::move(volume).value()});
     if (sources) sources->push_back(path);
   }
   return cts;
@@ -209,12 +219,14 @@ Result<StudyDefinition> checkOptions(const EvaluateOptions& o) {
   return known;
 }
 
-/// Loads the CTs of the checked study `known` and defines it over them. For a run, checks (or writes) DIR/setup.txt
-/// against the trials in `store`; a merge checks its folders later (StudyMerge). Fails with the message to report.
-Result<PreparedStudy> prepareStudy(const EvaluateOptions& o, const StudyDefinition& known, const TrialStore* store) {
+/// Loads the CTs of the checked study `known` (only the one labelled `onlyLabel` when it names one) and defines it over
+/// them. For a run, checks (or writes) DIR/setup.txt against the trials in `store`; a merge checks its folders later
+/// (StudyMerge). Fails with the message to report.
+Result<PreparedStudy> prepareStudy(const EvaluateOptions& o, const StudyDefinition& known, const TrialStore* store,
+                                   const std::string& onlyLabel = {}) {
   PreparedStudy prepared;
   // The CTs are found before setup.txt is written, so that a run without them leaves no setup behind.
-  auto cts = loadCts(o, &prepared.ctSources);
+  auto cts = loadCts(o, &prepared.ctSources, onlyLabel);
   if (!cts) return fail(cts.error());
   std::vector<std::string> labels;
   for (const StudyCt& ct : cts.value()) labels.push_back(ct.label);
@@ -378,10 +390,12 @@ int runWriteTrial(const EvaluateOptions& o, const StudyDefinition& known) {
                                    "the study's report and a 0-based trial), got '{}'",
                                    o.writeTrial));
   }
-  auto prepared = prepareStudy(o, known, nullptr);
+  const std::string condition = o.writeTrial.substr(0, colon);
+  // A condition's name starts with its CT's label: only that CT is loaded (all of them when none matches, so that an
+  // unknown condition's message lists every condition).
+  auto prepared = prepareStudy(o, known, nullptr, condition.substr(0, condition.find('/')));
   if (!prepared) return reportError(prepared.error());
   const PreparedStudy& p = prepared.value();
-  const std::string condition = o.writeTrial.substr(0, colon);
   const auto named = std::find_if(p.study.conditions.begin(), p.study.conditions.end(),
                                   [&](const StudyCondition& c) { return c.name == condition; });
   fs::path ctSource;

@@ -99,17 +99,24 @@ RegistrationResult cancelledBeforeFirstStage(RegistrationResult result, const Ei
   return result;
 }
 
-/// Every stage's objective (pixel sets and metric), built before the first search so that a stage that cannot run
-/// fails the registration at once instead of after the earlier stages' work. Fails with the failing stage's message.
+/// The objective of `stage` (pixel sets, cut-face masks and coarse CT made at `T_at`, LPS mm). Fails with the
+/// stage's message.
+Result<RegistrationObjective> objectiveAt(RegistrationCase& registrationCase, const RegistrationStage& stage,
+                                          const RegistrationAblation& ablation, bool useViewRenderers,
+                                          const Eigen::Isometry3d& T_at) {
+  return RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
+                                       ablation.noCtPyramid ? std::nullopt : std::optional(T_at), std::optional(T_at));
+}
+
+/// Every stage's objective at the initial pose, built before the first search so that a stage that cannot run fails
+/// the registration at once instead of after the earlier stages' work. Fails with the failing stage's message.
 Result<std::vector<RegistrationObjective>> createObjectives(RegistrationCase& registrationCase,
                                                             const RegistrationSchedule& schedule,
                                                             const RegistrationAblation& ablation,
                                                             bool useViewRenderers, const Eigen::Isometry3d& T_initial) {
   std::vector<RegistrationObjective> objectives;
   for (const RegistrationStage& stage : schedule.stages) {
-    auto created = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
-                                                 ablation.noCtPyramid ? std::nullopt : std::optional(T_initial),
-                                                 std::optional(T_initial));
+    auto created = objectiveAt(registrationCase, stage, ablation, useViewRenderers, T_initial);
     if (!created) return fail(created.error());
     objectives.push_back(std::move(created).value());
   }
@@ -184,10 +191,16 @@ double boneMotionBound_mm(const RegistrationCase& registrationCase, const Eigen:
 /// Rounds of shift pre-alignment at most.
 constexpr int kShiftPrealignRounds = 3;
 
+/// What a stage's shift pre-alignment did.
+struct PrealignOutcome {
+  Eigen::Vector3d shift_world_mm = Eigen::Vector3d::Zero();  ///< the translation added in all (LPS mm)
+  double similarity = 0.0;                                   ///< the stage's similarity at the (moved) start
+};
+
 /// Shift pre-alignment of a stage (ProjectionShiftAligner at its level, repeated): moves `current` by each alignment
-/// that raises the stage's similarity (`objective`) and returns the translation added in all (LPS mm; zero when the
-/// first did not). Fails, naming the stage, on a rendering error.
-Result<Eigen::Vector3d> prealignByShift(RegistrationCase& registrationCase, const RegistrationStage& stage,
+/// that raises the stage's similarity (`objective`). Returns the translation added in all (zero when the first did
+/// not raise it) and the similarity at the resulting start. Fails, naming the stage, on a rendering error.
+Result<PrealignOutcome> prealignByShift(RegistrationCase& registrationCase, const RegistrationStage& stage,
                                         RegistrationObjective& objective, PoseVector& current) {
   const auto failed = [&](const std::string& error) { return fail(fmt::format("stage '{}': {}", stage.name, error)); };
   Eigen::Isometry3d T_current = registrationCase.poseTransform(current);
@@ -210,25 +223,31 @@ Result<Eigen::Vector3d> prealignByShift(RegistrationCase& registrationCase, cons
     similarity = after;
     total_world_mm += aligned.value().translation_world_mm;
   }
-  return total_world_mm;
+  return PrealignOutcome{total_world_mm, similarity.value()};
 }
 
 /// Runs stage `stageIndex` from `current` (pose parameters, deg and mm), moving `current` to the stage's best pose;
 /// `drrsBefore` counts the earlier stages' DRRs for the progress reports; `prealignShift_world_mm` is the move of the
-/// stage's shift pre-alignment, for the report. Returns the stage's report; fails, naming
-/// the stage, on a rendering or search error.
+/// stage's shift pre-alignment, for the report; `knownStartSimilarity` is the objective's value at `current` when the
+/// pre-alignment knows it (NaN: evaluated here). Returns the stage's report; fails, naming the stage, on a rendering or
+/// search error.
 Result<StageReport> runStage(const StageContext& context, int stageIndex, const RegistrationStage& stage,
                              RegistrationObjective& objective, long drrsBefore,
-                             const Eigen::Vector3d& prealignShift_world_mm, PoseVector& current) {
+                             const Eigen::Vector3d& prealignShift_world_mm, double knownStartSimilarity,
+                             PoseVector& current) {
   const auto stageStart = Clock::now();
   const std::clock_t stageCpuStart = std::clock();
   RegistrationCase& registrationCase = context.registrationCase;
-  auto startValue = objective.similarity(registrationCase.poseTransform(current));
-  if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
-  StageReport report = startReport(stage, startValue.value(), objective);
+  double startSimilarity = knownStartSimilarity;
+  if (std::isnan(startSimilarity)) {
+    auto startValue = objective.similarity(registrationCase.poseTransform(current));
+    if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
+    startSimilarity = startValue.value();
+  }
+  StageReport report = startReport(stage, startSimilarity, objective);
   report.prealignShift_world_mm = prealignShift_world_mm;
 
-  RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startValue.value());
+  RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startSimilarity);
   std::string renderError;
   const PoseObjective f = [&](const PoseVector& params) {
     auto value = objective.similarity(registrationCase.poseTransform(params));
@@ -261,6 +280,11 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
 }
 
 }  // namespace
+
+std::string prealignShiftNote(const StageReport& report) {
+  if (report.prealignShift_world_mm.isZero()) return {};
+  return fmt::format("start moved {:.1f} mm by shift pre-alignment", report.prealignShift_world_mm.norm());
+}
 
 Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
                                              const RegistrationOptions& options,
@@ -298,23 +322,25 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
     const auto i = static_cast<std::size_t>(s);
     const RegistrationStage& stage = schedule.stages[i];
     Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();
+    double startSimilarity = std::numeric_limits<double>::quiet_NaN();  // unknown until the pre-alignment evaluates it
     if (stage.shiftPrealign) {
-      auto shift = prealignByShift(registrationCase, stage, objectives.value()[i], current);
-      if (!shift) return fail(shift.error());
-      prealignShift_world_mm = shift.value();
+      auto outcome = prealignByShift(registrationCase, stage, objectives.value()[i], current);
+      if (!outcome) return fail(outcome.error());
+      prealignShift_world_mm = outcome.value().shift_world_mm;
+      startSimilarity = outcome.value().similarity;
     }
     // A stage whose start lies far from the run's initial pose (after a far start's first stage, or its shift
-    // pre-alignment) makes its pixel sets (cut-face masks) and coarse CT again at its own start pose.
+    // pre-alignment) makes its pixel sets (cut-face masks) and coarse CT again at its own start pose; a similarity
+    // made with the old ones no longer holds.
     const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
     if (boneMotionBound_mm(registrationCase, T_initial, T_stageStart) > kObjectiveRebuildDistance_mm) {
-      auto rebuilt = RegistrationObjective::create(registrationCase, stage, useViewRenderers && !stage.exactDrr,
-                                                   options.ablation.noCtPyramid ? std::nullopt
-                                                                                : std::optional(T_stageStart),
-                                                   std::optional(T_stageStart));
+      auto rebuilt = objectiveAt(registrationCase, stage, options.ablation, useViewRenderers, T_stageStart);
       if (!rebuilt) return fail(rebuilt.error());
       objectives.value()[i] = std::move(rebuilt).value();
+      startSimilarity = std::numeric_limits<double>::quiet_NaN();
     }
-    auto report = runStage(context, s, stage, objectives.value()[i], result.totalDrrs, prealignShift_world_mm, current);
+    auto report = runStage(context, s, stage, objectives.value()[i], result.totalDrrs, prealignShift_world_mm,
+                           startSimilarity, current);
     if (!report) return fail(report.error());
     result.totalDrrs += report.value().drrs;
     result.stages.push_back(std::move(report).value());

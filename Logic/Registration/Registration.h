@@ -67,6 +67,10 @@ struct StageReport {
   bool cancelled = false;
   Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the stage's final pose (LPS mm)
 };
+/// "start moved N mm by shift pre-alignment" for a stage whose start its shift pre-alignment moved, or "" when it
+/// did not: one wording for the CLI and the Studio.
+std::string prealignShiftNote(const StageReport& report);
+
 /// Receives each stage's report as the stage ends (called on the registration's thread).
 using RegistrationStageCallback = std::function<void(const StageReport&)>;
 

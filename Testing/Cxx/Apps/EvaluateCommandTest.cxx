@@ -351,6 +351,23 @@ TEST(EvaluateCommand, WriteTrialWritesACaseThatTheRegisterCommandItPrintsRuns) {
       << startStre << "\n" << registered.out;
 }
 
+TEST(EvaluateCommand, WriteTrialLoadsOnlyItsConditionsCt) {
+  FCT_REQUIRE_DATA("ct/pelvis_totalseg.nii.gz");
+  FCT_REQUIRE_DATA("ct/head_phantom_philips_bone");
+  const auto dir = fct::test::scratchDir();
+  const ScopedDataDir data(fct::test::dataDir());
+  const auto run = fct::test::runCli(fmt::format("evaluate --study table2 --detector 160x128 --pixel-mm 2.4 "
+                                                 "--write-trial head/ideal:0 --out '{}'",
+                                                 (dir / "case").string()));
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  EXPECT_NE(run.err.find("loading CT " + (fct::test::dataDir() / "ct/head_phantom_philips_bone").string()),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(run.err.find("pelvis_totalseg"), std::string::npos) << "the pelvis is not loaded for a head trial\n"
+                                                                 << run.err;
+  EXPECT_TRUE(fs::exists(dir / "case" / "views.json"));
+}
+
 TEST(EvaluateCommand, WriteTrialRefusesABadTrialNameWithOneErrorLine) {
   const auto dir = fct::test::scratchDir();
   const auto run = [&](const std::string& trial) {
