@@ -124,19 +124,20 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
   if (!positive(spacing_mm) || !positive(o.backgroundWindow_mm) || !positive(o.narrowWindow_mm) ||
       !positive(o.contrastWindow_mm) || !positive(o.minExcess) || !positive(o.maxContrastRatio) ||
       !positive(o.maxSagitta_mm) || !positive(o.seedContrastRatio) || !positive(o.denseExcess) ||
-      !positive(o.denseContrastRatio) || !positive(o.veryDenseExcess) || !(o.minLength_mm >= 0.0) ||
-      !(o.minClippedLength_mm >= 0.0) || !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) ||
+      !positive(o.denseContrastRatio) || !positive(o.veryDenseExcess) || !positive(o.compactExcess) ||
+      !positive(o.compactContrastRatio) || !(o.minLength_mm >= 0.0) || !(o.minClippedLength_mm >= 0.0) ||
+      !(o.minDenseLength_mm >= 0.0) || !(o.minVeryDenseLength_mm >= 0.0) || !(o.minCompactWidth_mm >= 0.0) ||
       !std::isfinite(o.growExcess) || !(o.growDistance_mm >= 0.0) || !std::isfinite(o.growDistance_mm) ||
       !(o.dilation_mm >= 0.0) || !std::isfinite(o.dilation_mm)) {
     return fail(fmt::format("metal detection options: assumed pixel spacing {} mm, windows ({}, {}, {} mm), "
-                            "minimum excess {}, dense and very dense excesses ({}, {}), contrast ratios ({}, {}, {}) "
-                            "and sagitta {} mm must be > 0; lengths ({}, {}, {}, {} mm), growth distance {} mm and "
-                            "dilation {} mm >= 0; fix the settings",
+                            "minimum excess {}, dense, very dense and compact excesses ({}, {}, {}), contrast ratios "
+                            "({}, {}, {}, {}) and sagitta {} mm must be > 0; lengths ({}, {}, {}, {}, {} mm), growth "
+                            "distance {} mm and dilation {} mm >= 0; fix the settings",
                             o.assumedPixelSpacing_mm, o.backgroundWindow_mm, o.narrowWindow_mm,
-                            o.contrastWindow_mm, o.minExcess, o.denseExcess, o.veryDenseExcess,
-                            o.maxContrastRatio, o.seedContrastRatio, o.denseContrastRatio, o.maxSagitta_mm,
-                            o.minLength_mm, o.minClippedLength_mm, o.minDenseLength_mm, o.minVeryDenseLength_mm,
-                            o.growDistance_mm, o.dilation_mm));
+                            o.contrastWindow_mm, o.minExcess, o.denseExcess, o.veryDenseExcess, o.compactExcess,
+                            o.maxContrastRatio, o.seedContrastRatio, o.denseContrastRatio, o.compactContrastRatio,
+                            o.maxSagitta_mm, o.minLength_mm, o.minClippedLength_mm, o.minDenseLength_mm,
+                            o.minVeryDenseLength_mm, o.minCompactWidth_mm, o.growDistance_mm, o.dilation_mm));
   }
   const auto toPixels = [spacing_mm](double length_mm) {
     return static_cast<int>(std::lround(length_mm / spacing_mm));
@@ -195,10 +196,14 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
     cv::Mat interior;
     cv::erode(valid != 0, interior, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)), cv::Point(-1, -1), 1,
               cv::BORDER_CONSTANT, cv::Scalar(0));
-    // A set of pixels' length along its longest side, mm.
+    // A set of pixels' extent along the longest and the shortest side of its smallest enclosing rectangle, mm.
     const auto length_mm = [spacing_mm](const std::vector<cv::Point>& pixels) {
       const cv::RotatedRect box = cv::minAreaRect(pixels);
       return (std::max(box.size.width, box.size.height) + 1.0) * spacing_mm;
+    };
+    const auto width_mm = [spacing_mm](const std::vector<cv::Point>& pixels) {
+      const cv::RotatedRect box = cv::minAreaRect(pixels);
+      return (std::min(box.size.width, box.size.height) + 1.0) * spacing_mm;
     };
     cv::Mat seeds = cv::Mat::zeros(rows, cols, CV_8U);
     for (std::size_t label = 1; label < pieces.size(); ++label) {
@@ -207,8 +212,11 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
       const double pieceLength_mm = length_mm(piece.pixels);
       const double wide = piece.wideExcessSum / count;
       const double ratio = piece.contrastRatioSum / count;
-      // Very dense pieces need no shape test (crossing wires make an X); the others must be straight.
+      // Very dense pieces and compact two-sided blobs need no shape test (crossing wires make an X, a tilted screw a
+      // head with a stub); the others must be straight.
       const bool veryDense = wide >= o.veryDenseExcess && pieceLength_mm >= o.minVeryDenseLength_mm;
+      const bool compact =
+          wide >= o.compactExcess && ratio < o.compactContrastRatio && width_mm(piece.pixels) >= o.minCompactWidth_mm;
       const bool clipped = std::any_of(piece.pixels.begin(), piece.pixels.end(), [&interior](const cv::Point& pixel) {
         return interior.at<std::uint8_t>(pixel) == 0;
       });
@@ -216,7 +224,7 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
           pieceLength_mm >= (clipped ? o.minClippedLength_mm : o.minLength_mm) && ratio < o.seedContrastRatio;
       const bool dense =
           wide >= o.denseExcess && pieceLength_mm >= o.minDenseLength_mm && ratio < o.denseContrastRatio;
-      if (veryDense || ((longThin || dense) && sagitta_px(piece.pixels) * spacing_mm <= o.maxSagitta_mm)) {
+      if (veryDense || compact || ((longThin || dense) && sagitta_px(piece.pixels) * spacing_mm <= o.maxSagitta_mm)) {
         for (const cv::Point& pixel : piece.pixels) seeds.at<std::uint8_t>(pixel) = 1;
         continue;
       }

@@ -12,7 +12,10 @@
 //   narrow opening minus the erosion over a disc of contrastWindow_mm; a candidate must stand above it by
 //   1 / maxContrastRatio at least;
 // - the candidates' connected pieces are tested as shapes. A piece seeds the metal when it is very dense (mean wide
-//   excess >= veryDenseExcess, length >= minVeryDenseLength_mm), or when it is straight (the sagitta of a parabola
+//   excess >= veryDenseExcess, length >= minVeryDenseLength_mm); when it is a compact two-sided blob (mean wide excess
+//   >= compactExcess, at least minCompactWidth_mm across its shorter side, mean contrast ratio < compactContrastRatio:
+//   a screw seen nearly end-on, its head and a short stub of shaft; bone's compact dense spots stand on a slope of
+//   bone and have ratios of 0.35 and more, and a short thin mark is not a blob); or when it is straight (the sagitta of a parabola
 //   fitted across the piece's axis is at most maxSagitta_mm: a rim is an arc) and either long with little bone
 //   contrast (length >= minLength_mm, mean contrast / narrow excess < seedContrastRatio) or dense (mean wide excess
 //   >= denseExcess, length >= minDenseLength_mm, mean ratio < denseContrastRatio). A piece that reaches the edge of
@@ -24,8 +27,8 @@
 //   for up to growDistance_mm (the rest of a wire over dense bone, a screw head), and the result is dilated by
 //   dilation_mm (at least 3 px) to cover the blurred edge of the shadow and the glare around it.
 // Not found: objects wider than the wide window; curved metal that is not very dense and has no straight bar of
-// minLength_mm; a screw seen end-on whose magnified head is wider than the narrow window and less than veryDenseExcess
-// above its surroundings; metal that stands less than minExcess above its surroundings (contrast-processed images;
+// minLength_mm; a screw seen exactly end-on whose magnified head is wider than the narrow window (only the shaft's
+// core then stands out, and is found when very dense); metal that stands less than minExcess above its surroundings (contrast-processed images;
 // thin wires over thick anatomy at coarse pixels).
 
 #include <cstddef>
@@ -53,6 +56,9 @@ struct MetalMaskOptions {
   double denseContrastRatio = 0.6;    ///< ... its mean contrast ratio is below this
   double veryDenseExcess = 3.0;       ///< a piece with this mean wide excess seeds metal when ...
   double minVeryDenseLength_mm = 2.0;  ///< ... at least this long
+  double compactExcess = 1.5;         ///< a piece with this mean wide excess seeds metal when ...
+  double minCompactWidth_mm = 4.0;    ///< ... at least this wide across its shorter side and ...
+  double compactContrastRatio = 0.25;  ///< ... its mean contrast ratio is below this (a two-sided blob)
   double growExcess = 0.5;            ///< seeds grow into pixels this far above the narrow opening ...
   double growDistance_mm = 25.0;      ///< ... up to this far
   double dilation_mm = 2.7;          ///< metal pixels are grown by this radius (square, at least 3 px) before exclusion

@@ -1,7 +1,7 @@
 // MetalMaskDetector: a dark (high line integral) thin bar is masked with its dilation, smooth bone and its edges are
 // not, nor a skull-like rim as dense as the bar, invalid pixels stay invalid and are not counted, a clean image loses
-// nothing, a short wire stub is metal only where the field's edge cuts it, a wire crossing a screw is still found, and
-// bad input fails.
+// nothing, a short wire stub is metal only where the field's edge cuts it, a screw seen nearly end-on is found and a
+// dense spot near a bone edge is not, a wire crossing a screw is still found, and bad input fails.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,6 +141,21 @@ TEST(MetalMaskDetector, ShortWireStubIsMetalOnlyWhereTheFieldEdgeCutsIt) {
   ASSERT_TRUE(metal.ok()) << metal.error();
   EXPECT_FALSE(metal.value().mask.isValid(140, 110)) << "the stub cut by the field edge";
   EXPECT_TRUE(metal.value().mask.isValid(20, 30)) << "a short mark inside the field is not seeded";
+}
+
+TEST(MetalMaskDetector, ScrewSeenNearlyEndOnIsMetalButADenseSpotNearTheBoneEdgeIsNot) {
+  // At 0.4 mm pixels: a titanium screw tilted toward the beam shows its head (a disc of 8 mm, adding 1.8) and a 4 mm
+  // stub of shaft, too short for a bar. A spot as dense (a disc of 6.4 mm) lies inside the bone disc 4 mm from its
+  // edge: bone around it on one side, soft tissue a few mm beyond on the other, as a dense spot of bone has.
+  fct::FloatImage image = boneImage(0.0f);
+  addBar(image, 125.0, 35.0, 125.01, 35.0, 10.0, 1.8f);
+  addBar(image, 125.0, 35.0, 131.0, 40.0, 5.0, 0.8f);
+  addBar(image, 60.0, 78.0, 60.01, 78.0, 8.0, 1.8f);
+  const auto metal = fct::MetalMaskDetector().detect(image, fct::ValidMask::allValid(160, 120), 0.4);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  EXPECT_FALSE(metal.value().mask.isValid(125, 35)) << "the screw's head";
+  EXPECT_FALSE(metal.value().mask.isValid(130, 39)) << "the stub of shaft";
+  EXPECT_TRUE(metal.value().mask.isValid(60, 78)) << "the dense spot near the bone edge";
 }
 
 TEST(MetalMaskDetector, WireCrossingAScrewIsStillFoundAsAStraightBar) {
