@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -197,26 +198,23 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
     cv::erode(valid != 0, interior, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)), cv::Point(-1, -1), 1,
               cv::BORDER_CONSTANT, cv::Scalar(0));
     // A set of pixels' extent along the longest and the shortest side of its smallest enclosing rectangle, mm.
-    const auto length_mm = [spacing_mm](const std::vector<cv::Point>& pixels) {
+    const auto extent_mm = [spacing_mm](const std::vector<cv::Point>& pixels) {
       const cv::RotatedRect box = cv::minAreaRect(pixels);
-      return (std::max(box.size.width, box.size.height) + 1.0) * spacing_mm;
-    };
-    const auto width_mm = [spacing_mm](const std::vector<cv::Point>& pixels) {
-      const cv::RotatedRect box = cv::minAreaRect(pixels);
-      return (std::min(box.size.width, box.size.height) + 1.0) * spacing_mm;
+      return std::pair((std::max(box.size.width, box.size.height) + 1.0) * spacing_mm,
+                       (std::min(box.size.width, box.size.height) + 1.0) * spacing_mm);
     };
     cv::Mat seeds = cv::Mat::zeros(rows, cols, CV_8U);
     for (std::size_t label = 1; label < pieces.size(); ++label) {
       const Piece& piece = pieces[label];
       const double count = static_cast<double>(piece.pixels.size());
-      const double pieceLength_mm = length_mm(piece.pixels);
+      const auto [pieceLength_mm, pieceWidth_mm] = extent_mm(piece.pixels);
       const double wide = piece.wideExcessSum / count;
       const double ratio = piece.contrastRatioSum / count;
       // Very dense pieces and compact two-sided blobs need no shape test (crossing wires make an X, a tilted screw a
       // head with a stub); the others must be straight.
       const bool veryDense = wide >= o.veryDenseExcess && pieceLength_mm >= o.minVeryDenseLength_mm;
       const bool compact =
-          wide >= o.compactExcess && ratio < o.compactContrastRatio && width_mm(piece.pixels) >= o.minCompactWidth_mm;
+          wide >= o.compactExcess && ratio < o.compactContrastRatio && pieceWidth_mm >= o.minCompactWidth_mm;
       const bool clipped = std::any_of(piece.pixels.begin(), piece.pixels.end(), [&interior](const cv::Point& pixel) {
         return interior.at<std::uint8_t>(pixel) == 0;
       });
@@ -236,7 +234,7 @@ Result<MetalMask> MetalMaskDetector::detect(const FloatImage& lineIntegrals, con
         double barRatio = 0.0;
         for (const cv::Point& pixel : bar) barRatio += contrastRatio.at<float>(pixel);
         barRatio /= static_cast<double>(bar.size());
-        if (length_mm(bar) >= o.minLength_mm && barRatio < o.seedContrastRatio &&
+        if (extent_mm(bar).first >= o.minLength_mm && barRatio < o.seedContrastRatio &&
             sagitta_px(bar) * spacing_mm <= o.maxSagitta_mm) {
           for (const cv::Point& pixel : bar) seeds.at<std::uint8_t>(pixel) = 1;
         }
