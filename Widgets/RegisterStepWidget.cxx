@@ -288,13 +288,13 @@ QString RegisterStepWidget::plainStageName(const std::string& stage) {
 
 void RegisterStepWidget::logStages(const RegistrationResult& result) {
   for (const StageReport& stage : result.stages) {
-    const std::string prealignNote = prealignShiftNote(stage);
+    const std::string startNote = stageStartNote(stage);
     appendLog(QString::fromStdString(fmt::format(
                   "  {}: {} at level {}, {} search, {} evaluations, {} DRRs, similarity {:.4f} -> {:.4f}, {:.1f} s{}{}",
                   plainStageName(stage.name).toStdString(), RegistrationSchedule::metricName(stage.metric), stage.level,
                   RegistrationSchedule::searchName(stage.search), stage.evaluations, stage.drrs, stage.startSimilarity,
                   stage.similarity, stage.seconds,
-                  prealignNote.empty() ? "" : ", " + prealignNote,
+                  startNote.empty() ? "" : ", " + startNote,
                   stage.cancelled ? " (cancelled)" : "")));
   }
 }

@@ -302,11 +302,11 @@ nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r,
 /// Prints one line per stage, the summary line and the error against the truth.
 void printResult(const Options& o, const RegistrationResult& r, const std::optional<TruthError>& error) {
   for (const StageReport& s : r.stages) {
-    const std::string prealignNote = prealignShiftNote(s);
+    const std::string startNote = stageStartNote(s);
     fmt::print("stage {:<16} {:>4} level {} {:<7} {:7.2f} s (cpu {:6.2f} s) {:7} DRRs  similarity {:.4f} -> {:.4f}{}{}{}\n",
                s.name, RegistrationSchedule::metricName(s.metric), s.level, RegistrationSchedule::searchName(s.search),
                s.seconds, s.cpuSeconds, s.drrs, s.startSimilarity, s.similarity,
-               prealignNote.empty() ? "" : fmt::format("  ({})", prealignNote),
+               startNote.empty() ? "" : fmt::format("  ({})", startNote),
                s.fallbackRays ? fmt::format("  ({} rays outside the Transgraph, exact)", s.fallbackRays) : "",
                s.cancelled ? " (cancelled)" : "");
   }

@@ -1,6 +1,7 @@
 #include "Registration/Registration.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "Geometry/RigidPose.h"
 #include "Registration/ProjectionShiftAligner.h"
 #include "Registration/RegistrationObjective.h"
+#include "Registration/RotationSweep.h"
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
 #include "Search/LocalPoseOptimizer.h"
@@ -32,13 +34,14 @@ double secondsSince(Clock::time_point start) {
 /// Process CPU time (all threads) since `start` (a std::clock() reading), seconds.
 double cpuSecondsSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
 
-/// The stage's search strategy with the stage's evaluation cap applied.
-std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage) {
+/// The stage's search strategy with the stage's evaluation cap applied; a genetic search also refines `extraSeeds`.
+std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage, const std::vector<PoseVector>& extraSeeds) {
   switch (stage.search) {
     case SearchStrategy::Genetic: {
       GeneticSearchOptions o = stage.genetic;
       o.local = stage.simplex;
       o.maxEvaluations = stage.maxEvaluations;
+      o.extraSeeds = extraSeeds;
       return std::make_unique<GeneticSearchOptimizer>(o);
     }
     case SearchStrategy::CmaEs: {
@@ -226,26 +229,65 @@ Result<PrealignOutcome> prealignByShift(RegistrationCase& registrationCase, cons
   return PrealignOutcome{total_world_mm, similarity.value()};
 }
 
+/// What came before a stage's search: its shift pre-alignment and rotation sweep.
+struct StageStart {
+  Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();  ///< the pre-alignment's move (LPS mm)
+  double similarity = std::numeric_limits<double>::quiet_NaN();      ///< at the start pose; NaN: not known yet
+  std::vector<PoseVector> sweepSeeds;  ///< rotation sweep poses that beat the start (deg, mm), best first
+};
+
+/// The stage's similarity at `current` (pose parameters), or `known` when that is not NaN. Fails, naming the stage.
+Result<double> startSimilarityAt(RegistrationCase& registrationCase, const RegistrationStage& stage,
+                                 RegistrationObjective& objective, const PoseVector& current, double known) {
+  if (!std::isnan(known)) return known;
+  auto value = objective.similarity(registrationCase.poseTransform(current));
+  if (!value) return fail(fmt::format("stage '{}': {}", stage.name, value.error()));
+  return value.value();
+}
+
+/// The stage's rotation sweep from `current`: fills start.sweepSeeds for a genetic search, or moves `current` to the
+/// sweep's best pose for the others. The grid is ranked on the stage's whole images at the sweep's pixel budget (made
+/// like the stage's objective, at `current`). Fails, naming the stage, on a rendering error.
+Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStage& stage,
+                      const RegistrationAblation& ablation, bool useViewRenderers, RegistrationObjective& objective,
+                      StageStart& start, PoseVector& current) {
+  auto startSimilarity = startSimilarityAt(registrationCase, stage, objective, current, start.similarity);
+  if (!startSimilarity) return fail(startSimilarity.error());
+  start.similarity = startSimilarity.value();
+  RegistrationStage gridStage = stage;
+  gridStage.pixels = PixelSetSpec{PixelSetKind::WholeImage, stage.pixels.windowSize, 1.0, stage.rotationSweep.maxPixels};
+  auto gridObjective =
+      objectiveAt(registrationCase, gridStage, ablation, useViewRenderers, registrationCase.poseTransform(current));
+  if (!gridObjective) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, gridObjective.error()));
+  auto found = RotationSweep::run(registrationCase, gridObjective.value(), objective, stage.rotationSweep, stage.level,
+                                  current, start.similarity);
+  if (!found) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, found.error()));
+  if (found.value().empty()) return Ok{};
+  if (stage.search != SearchStrategy::Genetic) {
+    current = found.value().front().params;
+    start.similarity = found.value().front().similarity;
+    start.sweepSeeds = {current};
+    return Ok{};
+  }
+  for (const RotationSweepCandidate& candidate : found.value()) start.sweepSeeds.push_back(candidate.params);
+  return Ok{};
+}
+
 /// Runs stage `stageIndex` from `current` (pose parameters, deg and mm), moving `current` to the stage's best pose;
-/// `drrsBefore` counts the earlier stages' DRRs for the progress reports; `prealignShift_world_mm` is the move of the
-/// stage's shift pre-alignment, for the report; `knownStartSimilarity` is the objective's value at `current` when the
-/// pre-alignment knows it (NaN: evaluated here). Returns the stage's report; fails, naming the stage, on a rendering or
-/// search error.
+/// `drrsBefore` counts the earlier stages' DRRs for the progress reports; `start` is what its pre-alignment and
+/// rotation sweep did. Returns the stage's report; fails, naming the stage, on a rendering or search error.
 Result<StageReport> runStage(const StageContext& context, int stageIndex, const RegistrationStage& stage,
-                             RegistrationObjective& objective, long drrsBefore,
-                             const Eigen::Vector3d& prealignShift_world_mm, double knownStartSimilarity,
+                             RegistrationObjective& objective, long drrsBefore, const StageStart& start,
                              PoseVector& current) {
   const auto stageStart = Clock::now();
   const std::clock_t stageCpuStart = std::clock();
   RegistrationCase& registrationCase = context.registrationCase;
-  double startSimilarity = knownStartSimilarity;
-  if (std::isnan(startSimilarity)) {
-    auto startValue = objective.similarity(registrationCase.poseTransform(current));
-    if (!startValue) return fail(fmt::format("stage '{}': {}", stage.name, startValue.error()));
-    startSimilarity = startValue.value();
-  }
+  auto knownSimilarity = startSimilarityAt(registrationCase, stage, objective, current, start.similarity);
+  if (!knownSimilarity) return fail(knownSimilarity.error());
+  const double startSimilarity = knownSimilarity.value();
   StageReport report = startReport(stage, startSimilarity, objective);
-  report.prealignShift_world_mm = prealignShift_world_mm;
+  report.prealignShift_world_mm = start.prealignShift_world_mm;
+  report.rotationSweepSeeds = static_cast<int>(start.sweepSeeds.size());
 
   RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startSimilarity);
   std::string renderError;
@@ -265,7 +307,8 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
     return -value.value();
   };
 
-  const std::unique_ptr<PoseOptimizer> optimizer = makeOptimizer(stage);
+  const std::unique_ptr<PoseOptimizer> optimizer =
+      makeOptimizer(stage, stage.search == SearchStrategy::Genetic ? start.sweepSeeds : std::vector<PoseVector>{});
   auto found = optimizer->minimize(f, current, registrationCase.scales(), context.monitor);
   if (!renderError.empty()) return fail(fmt::format("stage '{}': {}", stage.name, renderError));
   if (const Status applied = applySearchOutcome(found, context.monitor, report, current); !applied) {
@@ -281,9 +324,18 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
 
 }  // namespace
 
-std::string prealignShiftNote(const StageReport& report) {
-  if (report.prealignShift_world_mm.isZero()) return {};
-  return fmt::format("start moved {:.1f} mm by shift pre-alignment", report.prealignShift_world_mm.norm());
+std::string stageStartNote(const StageReport& report) {
+  std::vector<std::string> notes;
+  if (!report.prealignShift_world_mm.isZero()) {
+    notes.push_back(fmt::format("start moved {:.1f} mm by shift pre-alignment", report.prealignShift_world_mm.norm()));
+  }
+  if (report.rotationSweepSeeds > 0 && report.search == SearchStrategy::Genetic) {
+    notes.push_back(fmt::format("{} rotation sweep pose{} searched beside the start", report.rotationSweepSeeds,
+                                report.rotationSweepSeeds == 1 ? "" : "s"));
+  } else if (report.rotationSweepSeeds > 0) {
+    notes.emplace_back("start moved to the rotation sweep's best pose");
+  }
+  return fmt::format("{}", fmt::join(notes, "; "));
 }
 
 Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_initial,
@@ -321,13 +373,12 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
     }
     const auto i = static_cast<std::size_t>(s);
     const RegistrationStage& stage = schedule.stages[i];
-    Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();
-    double startSimilarity = std::numeric_limits<double>::quiet_NaN();  // unknown until the pre-alignment evaluates it
+    StageStart stageStart;
     if (stage.shiftPrealign) {
       auto outcome = prealignByShift(registrationCase, stage, objectives.value()[i], current);
       if (!outcome) return fail(outcome.error());
-      prealignShift_world_mm = outcome.value().shift_world_mm;
-      startSimilarity = outcome.value().similarity;
+      stageStart.prealignShift_world_mm = outcome.value().shift_world_mm;
+      stageStart.similarity = outcome.value().similarity;
     }
     // A stage whose start lies far from the run's initial pose (after a far start's first stage, or its shift
     // pre-alignment) makes its pixel sets (cut-face masks) and coarse CT again at its own start pose; a similarity
@@ -337,10 +388,14 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       auto rebuilt = objectiveAt(registrationCase, stage, options.ablation, useViewRenderers, T_stageStart);
       if (!rebuilt) return fail(rebuilt.error());
       objectives.value()[i] = std::move(rebuilt).value();
-      startSimilarity = std::numeric_limits<double>::quiet_NaN();
+      stageStart.similarity = std::numeric_limits<double>::quiet_NaN();
     }
-    auto report = runStage(context, s, stage, objectives.value()[i], result.totalDrrs, prealignShift_world_mm,
-                           startSimilarity, current);
+    if (stage.rotationSweep.maxRotation_deg > 0.0) {
+      const Status swept = sweepRotations(registrationCase, stage, options.ablation, useViewRenderers,
+                                          objectives.value()[i], stageStart, current);
+      if (!swept) return fail(swept.error());
+    }
+    auto report = runStage(context, s, stage, objectives.value()[i], result.totalDrrs, stageStart, current);
     if (!report) return fail(report.error());
     result.totalDrrs += report.value().drrs;
     result.stages.push_back(std::move(report).value());

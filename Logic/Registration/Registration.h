@@ -64,12 +64,15 @@ struct StageReport {
   /// The translation its shift pre-alignment added to the stage's start (LPS mm); zero without one, or when the moved
   /// start did not raise the similarity (then the start is kept).
   Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();
+  /// Poses of its rotation sweep that beat the start: refined beside it (genetic), or the start moved to the best (1).
+  int rotationSweepSeeds = 0;
   bool cancelled = false;
   Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the stage's final pose (LPS mm)
 };
-/// "start moved N mm by shift pre-alignment" for a stage whose start its shift pre-alignment moved, or "" when it
-/// did not: one wording for the CLI and the Studio.
-std::string prealignShiftNote(const StageReport& report);
+/// What happened before a stage's search, "" when nothing did: "start moved N mm by shift pre-alignment" and
+/// "K rotation sweep poses searched beside the start" / "start moved to the rotation sweep's best pose". One wording
+/// for the CLI and the Studio.
+std::string stageStartNote(const StageReport& report);
 
 /// Receives each stage's report as the stage ends (called on the registration's thread).
 using RegistrationStageCallback = std::function<void(const StageReport&)>;

@@ -105,6 +105,7 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
     stage.keptFraction.push_back(value->get<double>());
   }
   if (reader.has("prealign_shift_mm")) stage.prealignShift_world_mm = reader.vector("prealign_shift_mm", 3);
+  if (reader.has("rotation_sweep_seeds")) stage.rotationSweepSeeds = reader.integer("rotation_sweep_seeds", 0);
   stage.cancelled = reader.boolean("cancelled");
   parent.adoptError(reader);
   return stage;
@@ -134,6 +135,7 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
     if (!s.prealignShift_world_mm.isZero()) {
       stages.back()["prealign_shift_mm"] = JsonDocument::array(s.prealignShift_world_mm);
     }
+    if (s.rotationSweepSeeds > 0) stages.back()["rotation_sweep_seeds"] = s.rotationSweepSeeds;
   }
   ordered_json initialPose = ordered_json::object();
   initialPose["T_world_from_ct"] = JsonDocument::array(result.T_initial.matrix());

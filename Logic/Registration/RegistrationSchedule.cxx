@@ -61,6 +61,29 @@ void readCmaEs(const nlohmann::json& object, const std::string& where, JsonReade
   parent.adoptError(reader);
 }
 
+/// Reads a stage's "rotation_sweep" object; rejects a radius outside (0, 180], a step outside (0, radius], or counts
+/// below 1 (seeds above aligned).
+void readRotationSweep(const nlohmann::json& object, const std::string& where, JsonReader& parent,
+                       RotationSweepSpec& o) {
+  JsonReader reader(object, where + ": rotation_sweep");
+  o.maxRotation_deg = reader.number("max_deg");
+  optionalNumber(reader, "step_deg", o.step_deg);
+  optionalInteger(reader, "aligned", 1, o.aligned);
+  optionalInteger(reader, "seeds", 1, o.seeds);
+  optionalInteger(reader, "max_pixels", 16, o.maxPixels);
+  if (reader.ok() && !(o.maxRotation_deg > 0.0 && o.maxRotation_deg <= 180.0)) {
+    reader.rejectKey("max_deg", fmt::format("is {}; use a radius above 0 and at most 180 deg", o.maxRotation_deg));
+  }
+  if (reader.ok() && !(o.step_deg > 0.0 && o.step_deg <= o.maxRotation_deg)) {
+    reader.rejectKey("step_deg", fmt::format("is {}; use a step above 0 and at most max_deg ({})", o.step_deg,
+                                             o.maxRotation_deg));
+  }
+  if (reader.ok() && o.seeds > o.aligned) {
+    reader.rejectKey("seeds", fmt::format("is {}; use at most aligned ({})", o.seeds, o.aligned));
+  }
+  parent.adoptError(reader);
+}
+
 /// Reads the optional boolean `key` into `flag`; rejects any other type.
 void optionalFlag(JsonReader& reader, const char* key, bool& flag) {
   const nlohmann::json* value = reader.find(key);
@@ -81,6 +104,7 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
   optionalFlag(reader, "exact_drr", stage.exactDrr);
   optionalFlag(reader, "shift_prealign", stage.shiftPrealign);
+  if (const nlohmann::json* sweep = reader.find("rotation_sweep")) readRotationSweep(*sweep, where, reader, stage.rotationSweep);
   if (reader.has("drr")) stage.drrMethod = parseName(reader, "drr", kStageDrrMethods);
   optionalNumber(reader, "drr_step_voxels", stage.drrStep_voxels);
   if (reader.ok() && reader.has("drr_step_voxels")) {
@@ -260,6 +284,13 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
     if (s.shiftPrealign) stageJson["shift_prealign"] = true;
+    if (s.rotationSweep.maxRotation_deg > 0.0) {
+      stageJson["rotation_sweep"] = {{"max_deg", s.rotationSweep.maxRotation_deg},
+                                     {"step_deg", s.rotationSweep.step_deg},
+                                     {"aligned", s.rotationSweep.aligned},
+                                     {"seeds", s.rotationSweep.seeds},
+                                     {"max_pixels", s.rotationSweep.maxPixels}};
+    }
     stageJson["pixels"] = std::move(pixels);
     stageJson["search"] = std::move(search);
     stagesJson.push_back(std::move(stageJson));

@@ -42,6 +42,15 @@ struct PixelSetSpec {
   int maxPixels = 0;
 };
 
+/// A stage's rotation sweep before its search (RotationSweep): none unless maxRotation_deg > 0.
+struct RotationSweepSpec {
+  double maxRotation_deg = 0.0;  ///< radius of the grid of rotation vectors, deg; 0 = no sweep
+  double step_deg = 20.0;        ///< grid spacing per axis, deg
+  int aligned = 8;               ///< the best grid poses that are shift-aligned and ranked again
+  int seeds = 2;                 ///< at most this many poses that beat the start go to the search
+  int maxPixels = 625;           ///< whole-image pixels per view that rank the grid (the stage's own set ranks the rest)
+};
+
 /// One stage of the schedule. Option units follow the optimizers: scaled units (about 1 mm of bone-surface motion),
 /// except the genetic spreads (deg, mm). The genetic drop threshold is in similarity units (mean over views).
 struct RegistrationStage {
@@ -62,6 +71,9 @@ struct RegistrationStage {
   /// stage's level (ProjectionShiftAligner), when that raises the stage's similarity: a far start's DRR then overlaps
   /// its X-ray before the search looks around it.
   bool shiftPrealign = false;
+  /// Before the search (after the shift pre-alignment), look around the start's rotation on a coarse grid; the poses
+  /// that beat the start are refined beside it (genetic) or replace it (local, CMA-ES: the best one).
+  RotationSweepSpec rotationSweep;
   PixelSetSpec pixels;
   SearchStrategy search = SearchStrategy::Local;
   int maxEvaluations = 1000;       ///< cap on DRR sets (one per view) of the stage's search

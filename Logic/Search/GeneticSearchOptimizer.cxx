@@ -54,6 +54,9 @@ Status GeneticSearchOptimizer::validateOptions() const {
   if (o.maxEvaluations <= 0) {
     return fail(fmt::format("genetic search maximum evaluations must be positive, got {}", o.maxEvaluations));
   }
+  for (const PoseVector& seed : o.extraSeeds) {
+    if (!seed.allFinite()) return fail("genetic search extra seeds must be finite poses");
+  }
   return LocalPoseOptimizer::create(o.local)->validateOptions();
 }
 
@@ -64,7 +67,7 @@ OptimizationResult GeneticSearchOptimizer::search(const PoseObjective& objective
   SeededRandom random(o.seed);
   const std::unique_ptr<LocalPoseOptimizer> local = LocalPoseOptimizer::create(o.local);
 
-  int planned = o.randomGuesses + 1;
+  int planned = o.randomGuesses + 1 + static_cast<int>(o.extraSeeds.size());
   for (int children = o.randomGuesses / 2, g = 1; children > 0 && g <= o.maxGenerations; children /= 2, ++g) {
     planned += children;
   }
@@ -80,6 +83,7 @@ OptimizationResult GeneticSearchOptimizer::search(const PoseObjective& objective
   };
 
   std::vector<PoseVector> seeds{start};
+  seeds.insert(seeds.end(), o.extraSeeds.begin(), o.extraSeeds.end());
   PoseVector spread;
   spread << Eigen::Vector3d::Constant(o.spreadRotation_deg), Eigen::Vector3d::Constant(o.spreadTranslation_mm);
   for (int i = 0; i < o.randomGuesses; ++i) {

@@ -4,9 +4,10 @@
 // best are dropped; n/2 new guesses are made as random pairwise combinations of the survivors on the pose manifold
 // and refined; the survivors and the new guesses form the next generation. The number of new guesses halves each
 // generation (n/2, n/4, ..., 1), and the search ends when one guess survives, no new guess is due, or a limit is hit.
-// With n = 4 that is 5 + 2 + 1 = 8 local searches. The same seed gives the same result.
+// With n = 4 that is 5 + 2 + 1 = 8 local searches (one more per extra seed). The same seed gives the same result.
 
 #include <cstdint>
+#include <vector>
 
 #include "Search/LocalPoseOptimizer.h"
 #include "Search/PoseOptimizer.h"
@@ -24,6 +25,9 @@ struct GeneticSearchOptions {
   int maxEvaluations = 20000;         ///< cap on objective evaluations of the whole search (> 0)
   std::uint32_t seed = 1;             ///< random seed; the same seed gives the same result
   LocalSearchOptions local;           ///< the local search run on every guess (simplex or BOBYQA)
+  /// Guesses besides the start and the random ones (deg, mm), refined with them in the initial population: poses a
+  /// coarse look elsewhere found promising (e.g. a rotation sweep's best). Empty by default.
+  std::vector<PoseVector> extraSeeds;
 };
 
 /// Genetic search with a local search (downhill simplex or BOBYQA) on every guess.

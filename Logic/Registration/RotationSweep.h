@@ -1,0 +1,46 @@
+#pragma once
+// RotationSweep: a coarse look around a far start's rotation before a stage's search. A start tens of degrees off
+// (a rough manual placement, the clinical setup alone) lies outside the basin the stage's search can reach: the genetic
+// search spreads its guesses a few degrees, and the shift pre-alignment corrects translation only. The sweep rotates
+// the start about the bone centre by every offset of a cubic grid of rotation vectors (spacing `step_deg`, within
+// `max_deg`), ranks them by the stage's similarity, lines the best few up in 2D with the ProjectionShiftAligner (which
+// a rotation of the bone about its own centre barely disturbs, but whose outline it changes), and returns those that
+// then beat the start: the stage's search refines them beside its start.
+
+#include <Eigen/Geometry>
+
+#include <vector>
+
+#include "Base/Result.h"
+#include "Geometry/PoseVector.h"
+#include "Registration/RegistrationCase.h"
+#include "Registration/RegistrationObjective.h"
+#include "Registration/RegistrationSchedule.h"
+
+namespace fct {
+
+/// One pose the sweep found better than its start.
+struct RotationSweepCandidate {
+  PoseVector params = PoseVector::Zero();  ///< pose parameters (deg about the bone centre, mm)
+  double similarity = 0.0;                 ///< the stage's similarity there
+  double offset_deg = 0.0;                 ///< the grid rotation it came from (angle about the bone centre)
+};
+
+/// The rotation grid search of one stage.
+class RotationSweep {
+ public:
+  /// The grid's rotation vectors (deg, world axes), zero excluded: every multiple of `step_deg` per axis whose length
+  /// is at most `max_deg`. Empty when max_deg < step_deg.
+  static std::vector<Eigen::Vector3d> offsets_deg(double max_deg, double step_deg);
+
+  /// The sweep of `spec` around `start` (pose parameters about the case's bone centre) at pyramid `level`: the grid
+  /// ranked by `gridObjective` (a sparser pixel set of the stage), the best spec.aligned shift-aligned and ranked by
+  /// the stage's `objective`. Returns at most spec.seeds candidates whose similarity beats `startSimilarity` (the
+  /// stage's), best first; empty when none does. Fails on a rendering error.
+  static Result<std::vector<RotationSweepCandidate>> run(RegistrationCase& registrationCase,
+                                                         RegistrationObjective& gridObjective,
+                                                         RegistrationObjective& objective, const RotationSweepSpec& spec,
+                                                         int level, const PoseVector& start, double startSimilarity);
+};
+
+}  // namespace fct
