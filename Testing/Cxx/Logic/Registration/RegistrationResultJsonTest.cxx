@@ -56,6 +56,7 @@ fct::RegistrationResult fullResult() {
   stage.similarity = 0.875;
   stage.keptFraction = {0.125, 0.0625};
   stage.prealignShift_world_mm = {12.5, -3.25, 0.5};
+  stage.rotationSweepSeeds = 2;
   r.stages = {stage};
   r.totalSeconds = 7.5;
   r.totalDrrs = 4000;
@@ -101,6 +102,7 @@ TEST(RegistrationResultJson, WritesEveryStageWithKeptFractionsByViewName) {
   EXPECT_TRUE(stages[1]["cancelled"].get<bool>());
   EXPECT_EQ(stages[1]["kept_fraction"].size(), 2u) << "a fraction without a view name is left out";
   EXPECT_FALSE(stages[0].contains("prealign_shift_mm")) << "written only for a stage whose start it moved";
+  EXPECT_FALSE(stages[0].contains("rotation_sweep_seeds")) << "written only for a stage its rotation sweep seeded";
 }
 
 TEST(RegistrationResultJson, NoStageGivesAnEmptyArray) {
@@ -142,6 +144,7 @@ TEST(RegistrationResultJson, WriteThenReadGivesTheSameResult) {
   EXPECT_EQ(s.similarity, 0.875);
   EXPECT_EQ(s.keptFraction, a.stages[0].keptFraction);
   EXPECT_EQ(s.prealignShift_world_mm, a.stages[0].prealignShift_world_mm);
+  EXPECT_EQ(s.rotationSweepSeeds, a.stages[0].rotationSweepSeeds);
   EXPECT_FALSE(s.cancelled);
   EXPECT_EQ(b.totalSeconds, 7.5);
   EXPECT_EQ(b.totalDrrs, 4000);

@@ -39,8 +39,10 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
   EXPECT_EQ(s[0].search, fct::SearchStrategy::Genetic);
   EXPECT_GT(s[0].pixels.maxPixels, 0) << "the global stage samples its level sparsely";
   EXPECT_TRUE(s[0].shiftPrealign) << "a far start is first lined up in 2D";
+  EXPECT_GE(s[0].rotationSweep.maxRotation_deg, 45.0) << "and looked around on a grid of rotations";
   for (std::size_t i = 1; i < s.size(); ++i) {
     EXPECT_FALSE(s[i].shiftPrealign);
+    EXPECT_EQ(s[i].rotationSweep.maxRotation_deg, 0.0);
     EXPECT_EQ(s[i].metric, fct::SimilarityMetric::Vlnc);
     EXPECT_EQ(s[i].pixels.kind, fct::PixelSetKind::Rois);
   }
@@ -114,6 +116,18 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
        "drr"},
       {stageHead + R"("metric": "ncc", "level": 2, "shift_prealign": 1, "pixels": {"set": "whole"}, )" + search + "]}",
        "shift_prealign"},
+      {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"step_deg": 10}, "pixels": {"set": "whole"}, )" +
+           search + "]}",
+       "max_deg"},
+      {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"max_deg": 0}, "pixels": {"set": "whole"}, )" +
+           search + "]}",
+       "max_deg"},
+      {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"max_deg": 30, "step_deg": 40}, )" +
+           R"("pixels": {"set": "whole"}, )" + search + "]}",
+       "step_deg"},
+      {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"max_deg": 30, "aligned": 2, "seeds": 3}, )" +
+           R"("pixels": {"set": "whole"}, )" + search + "]}",
+       "seeds"},
       {stageHead + R"("metric": "ncc", "level": 0, "drr_step_voxels": 1, "pixels": {"set": "whole"}, )" + search + "]}",
        "drr_step_voxels"},
       {stageHead + R"("metric": "ncc", "level": 0, "drr": "raycast", "drr_step_voxels": 0, "pixels": {"set": "whole"}, )" +

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <limits>
 
@@ -89,6 +90,35 @@ TEST(GeneticSearchOptimizer, EscapesLocalMinimumWhereSimplexIsTrapped) {
     found += t::scaledDistance(r.value().params, target, scales) < 0.05;
   }
   EXPECT_GE(found, 10);
+}
+
+TEST(GeneticSearchOptimizer, AnExtraSeedInAFarBasinIsRefinedBesideTheStart) {
+  const PoseVector scales = t::unitScales();
+  const PoseVector target = t::targetPose();
+  PoseVector start = target;
+  start[0] += 60.0;  // 60 scaled units away: far beyond the random guesses' spread of 6
+  // Two wells: a shallow one (value 1) at the start, the deep one (0) at the target.
+  const fct::PoseObjective twoWells = [&](const PoseVector& p) {
+    return std::min((p - start).squaredNorm() + 1.0, (p - target).squaredNorm());
+  };
+  const auto alone = GeneticSearchOptimizer(bumpyOptions(5)).minimize(twoWells, start, scales);
+  ASSERT_TRUE(alone.ok()) << alone.error();
+  EXPECT_GT(alone.value().value, 0.9) << "without the seed the search stays in the start's well";
+
+  GeneticSearchOptions withSeed = bumpyOptions(5);
+  PoseVector seed = target;
+  seed[3] += 4.0;
+  withSeed.extraSeeds = {seed};
+  const auto seeded = GeneticSearchOptimizer(withSeed).minimize(twoWells, start, scales);
+  ASSERT_TRUE(seeded.ok()) << seeded.error();
+  EXPECT_LT(seeded.value().value, 1e-3);
+  EXPECT_LT(t::scaledDistance(seeded.value().params, target, scales), 0.05);
+  EXPECT_EQ(seeded.value().generations.front().populationSize, 6) << "start + 4 random guesses + the seed";
+
+  withSeed.extraSeeds = {PoseVector::Constant(std::numeric_limits<double>::quiet_NaN())};
+  const auto bad = GeneticSearchOptimizer(withSeed).minimize(twoWells, start, scales);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().find("extra seeds"), std::string::npos) << bad.error();
 }
 
 TEST(GeneticSearchOptimizer, SameSeedGivesIdenticalResultAndOtherSeedDiffers) {

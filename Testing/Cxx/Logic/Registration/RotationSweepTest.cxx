@@ -1,0 +1,118 @@
+// RotationSweep: the grid of rotation offsets, a start turned 40 deg about the bone centre brought back within a grid
+// step by the sweep (and registered with the default preset), and a start at the truth left alone.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "Registration/Registration.h"
+#include "Registration/RegistrationObjective.h"
+#include "Registration/RotationSweep.h"
+#include "RegistrationTestCase.h"
+
+namespace {
+
+struct Prepared {
+  fct::test::KnownTruthCase simulated;
+  fct::RegistrationCase registrationCase;
+};
+
+/// The small phantom in the three standard views on a 128x128 detector at 2.4 mm.
+Prepared prepare() {
+  fct::test::KnownTruthOptions options;
+  options.cols = options.rows = 128;
+  options.pixelSpacing_mm = 2.4;
+  auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), options);
+  EXPECT_TRUE(simulated.ok()) << simulated.error();
+  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {});
+  EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
+  return Prepared{std::move(simulated).value(), std::move(registrationCase).value()};
+}
+
+/// The truth turned by `angle_deg` about `axis` through the bone centre.
+Eigen::Isometry3d turned(const Prepared& p, double angle_deg, const Eigen::Vector3d& axis) {
+  const Eigen::Vector3d centre_world_mm = p.simulated.T_truth * p.registrationCase.rotationCentre_ct_mm();
+  return Eigen::Translation3d(centre_world_mm) * Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis.normalized()) *
+         Eigen::Translation3d(-centre_world_mm) * p.simulated.T_truth;
+}
+
+double angleBetween_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() * 180.0 / M_PI;
+}
+
+/// The default preset's global stage.
+fct::RegistrationStage globalStage() {
+  return fct::RegistrationSchedule::builtin(fct::RegistrationSchedule::kDefaultPreset).value().stages.front();
+}
+
+}  // namespace
+
+TEST(RotationSweep, GridHoldsEveryMultipleOfTheStepWithinTheRadiusButZero) {
+  const auto offsets = fct::RotationSweep::offsets_deg(60.0, 15.0);
+  EXPECT_EQ(offsets.size(), 256u) << "integer points of a ball of radius 4, less the centre";
+  for (const Eigen::Vector3d& r : offsets) {
+    EXPECT_LE(r.norm(), 60.0 + 1e-9);
+    EXPECT_GT(r.norm(), 0.0);
+    for (int a = 0; a < 3; ++a) EXPECT_DOUBLE_EQ(std::remainder(r[a], 15.0), 0.0);
+  }
+  EXPECT_TRUE(fct::RotationSweep::offsets_deg(10.0, 15.0).empty());
+  EXPECT_TRUE(fct::RotationSweep::offsets_deg(60.0, 0.0).empty());
+}
+
+TEST(RotationSweep, BringsAStartTurned40DegreesWithinAGridStepAndLeavesTheTruthAlone) {
+  Prepared p = prepare();
+  const fct::RegistrationStage stage = globalStage();
+  ASSERT_GT(stage.rotationSweep.maxRotation_deg, 0.0);
+  auto objective = fct::RegistrationObjective::create(p.registrationCase, stage);
+  ASSERT_TRUE(objective.ok()) << objective.error();
+  fct::RegistrationStage gridStage = stage;
+  gridStage.pixels.maxPixels = stage.rotationSweep.maxPixels;
+  auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage);
+  ASSERT_TRUE(gridObjective.ok()) << gridObjective.error();
+
+  const Eigen::Vector3d centre_ct_mm = p.registrationCase.rotationCentre_ct_mm();
+  for (const Eigen::Vector3d& axis : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, -2, 1)}) {
+    SCOPED_TRACE(axis.transpose());
+    const Eigen::Isometry3d T_start = turned(p, 40.0, axis);
+    const auto start = fct::RigidPose::fromTransform(T_start, centre_ct_mm).value().asVector();
+    const double startSimilarity = objective.value().similarity(T_start).value();
+    auto found = fct::RotationSweep::run(p.registrationCase, gridObjective.value(), objective.value(),
+                                         stage.rotationSweep, stage.level, start, startSimilarity);
+    ASSERT_TRUE(found.ok()) << found.error();
+    ASSERT_FALSE(found.value().empty()) << "a pose nearer the truth beats a start turned 40 deg";
+    EXPECT_LE(static_cast<int>(found.value().size()), stage.rotationSweep.seeds);
+    const auto& best = found.value().front();
+    EXPECT_GT(best.similarity, startSimilarity);
+    const Eigen::Isometry3d T_best = p.registrationCase.poseTransform(best.params);
+    std::printf("best of %zu: %.1f deg from the truth (offset %.1f deg), similarity %.4f (start %.4f)\n",
+                found.value().size(), angleBetween_deg(T_best, p.simulated.T_truth), best.offset_deg, best.similarity,
+                startSimilarity);
+    EXPECT_LT(angleBetween_deg(T_best, p.simulated.T_truth), 15.0);
+    for (std::size_t i = 1; i < found.value().size(); ++i) {
+      EXPECT_LE(found.value()[i].similarity, found.value()[i - 1].similarity) << "best first";
+    }
+  }
+
+  const auto truth = fct::RigidPose::fromTransform(p.simulated.T_truth, centre_ct_mm).value().asVector();
+  const double truthSimilarity = objective.value().similarity(p.simulated.T_truth).value();
+  auto atTruth = fct::RotationSweep::run(p.registrationCase, gridObjective.value(), objective.value(),
+                                         stage.rotationSweep, stage.level, truth, truthSimilarity);
+  ASSERT_TRUE(atTruth.ok()) << atTruth.error();
+  EXPECT_TRUE(atTruth.value().empty()) << "no grid pose beats the truth";
+}
+
+TEST(RotationSweep, TheDefaultPresetRegistersAStartTurned45Degrees) {
+  Prepared p = prepare();
+  fct::RegistrationOptions options;
+  options.schedule = fct::RegistrationSchedule::builtin(fct::RegistrationSchedule::kDefaultPreset).value();
+  options.seed = 4;
+  const Eigen::Isometry3d start = turned(p, 45.0, Eigen::Vector3d(2, 1, -1));
+  auto result = fct::Registration::run(p.registrationCase, start, options);
+  ASSERT_TRUE(result.ok()) << result.error();
+  const double error_mm = p.registrationCase.bone()->meanDistance_mm(result.value().T_world_from_ct, p.simulated.T_truth);
+  const fct::StageReport& global = result.value().stages.front();
+  std::printf("from %.1f mm: %.3f mm (%s)\n", p.registrationCase.bone()->meanDistance_mm(start, p.simulated.T_truth),
+              error_mm, fct::stageStartNote(global).c_str());
+  EXPECT_GE(global.rotationSweepSeeds, 1);
+  EXPECT_NE(fct::stageStartNote(global).find("rotation sweep"), std::string::npos) << fct::stageStartNote(global);
+  EXPECT_LT(error_mm, 0.5);
+}
