@@ -231,9 +231,12 @@ Result<PrealignOutcome> prealignByShift(RegistrationCase& registrationCase, cons
 
 /// What came before a stage's search: its shift pre-alignment and rotation sweep.
 struct StageStart {
+  Clock::time_point began = Clock::now();  ///< when the stage began, its pre-alignment and sweep included
+  std::clock_t cpuBegan = std::clock();    ///< the process CPU clock then
   Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();  ///< the pre-alignment's move (LPS mm)
   double similarity = std::numeric_limits<double>::quiet_NaN();      ///< at the start pose; NaN: not known yet
   std::vector<PoseVector> sweepSeeds;  ///< rotation sweep poses that beat the start (deg, mm), best first
+  long sweepGridDrrs = 0;              ///< DRRs the sweep's grid ranking rendered (its own sparser objective)
 };
 
 /// The stage's similarity at `current` (pose parameters), or `known` when that is not NaN. Fails, naming the stage.
@@ -261,6 +264,7 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
   if (!gridObjective) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, gridObjective.error()));
   auto found = RotationSweep::run(registrationCase, gridObjective.value(), objective, stage.rotationSweep, stage.level,
                                   current, start.similarity);
+  start.sweepGridDrrs = gridObjective.value().drrCount();
   if (!found) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, found.error()));
   if (found.value().empty()) return Ok{};
   if (stage.search != SearchStrategy::Genetic) {
@@ -279,8 +283,6 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
 Result<StageReport> runStage(const StageContext& context, int stageIndex, const RegistrationStage& stage,
                              RegistrationObjective& objective, long drrsBefore, const StageStart& start,
                              PoseVector& current) {
-  const auto stageStart = Clock::now();
-  const std::clock_t stageCpuStart = std::clock();
   RegistrationCase& registrationCase = context.registrationCase;
   auto knownSimilarity = startSimilarityAt(registrationCase, stage, objective, current, start.similarity);
   if (!knownSimilarity) return fail(knownSimilarity.error());
@@ -298,7 +300,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
       return std::numeric_limits<double>::quiet_NaN();
     }
     ++progress.iteration;
-    progress.drrs = drrsBefore + objective.drrCount();
+    progress.drrs = drrsBefore + start.sweepGridDrrs + objective.drrCount();
     progress.bestSimilarity = std::max(progress.bestSimilarity, value.value());
     progress.fraction =
         (stageIndex + std::min(1.0, static_cast<double>(progress.iteration) / progress.maxIterations)) /
@@ -314,10 +316,10 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   if (const Status applied = applySearchOutcome(found, context.monitor, report, current); !applied) {
     return fail(fmt::format("stage '{}': {}", stage.name, applied.error()));
   }
-  report.drrs = objective.drrCount();
+  report.drrs = objective.drrCount() + start.sweepGridDrrs;
   report.fallbackRays = objective.fallbackRayCount();
-  report.seconds = secondsSince(stageStart);
-  report.cpuSeconds = cpuSecondsSince(stageCpuStart);
+  report.seconds = secondsSince(start.began);
+  report.cpuSeconds = cpuSecondsSince(start.cpuBegan);
   report.T_world_from_ct = registrationCase.poseTransform(current);
   return report;
 }

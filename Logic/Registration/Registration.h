@@ -55,7 +55,7 @@ struct StageReport {
   SearchStrategy search = SearchStrategy::Local;
   double seconds = 0.0;
   double cpuSeconds = 0.0;         ///< process CPU time (every thread) during the stage: less load-sensitive than seconds
-  long drrs = 0;                   ///< DRRs rendered in the stage (evaluations x views)
+  long drrs = 0;                   ///< DRRs rendered in the stage (its evaluations and its rotation sweep, x views)
   long fallbackRays = 0;           ///< Transgraph rays outside their table, integrated exactly (0 for other methods)
   int evaluations = 0;
   double startSimilarity = 0.0;    ///< at the stage's start pose
