@@ -34,7 +34,8 @@ double secondsSince(Clock::time_point start) {
 /// Process CPU time (all threads) since `start` (a std::clock() reading), seconds.
 double cpuSecondsSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
 
-/// The stage's search strategy with the stage's evaluation cap applied; a genetic search also refines `extraSeeds`.
+/// The stage's search strategy with the stage's evaluation cap applied; a genetic search also refines `extraSeeds`
+/// (the other strategies search from their start only).
 std::unique_ptr<PoseOptimizer> makeOptimizer(const RegistrationStage& stage, const std::vector<PoseVector>& extraSeeds) {
   switch (stage.search) {
     case SearchStrategy::Genetic: {
@@ -267,13 +268,12 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
   start.sweepGridDrrs = gridObjective.value().drrCount();
   if (!found) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, found.error()));
   if (found.value().empty()) return Ok{};
-  if (stage.search != SearchStrategy::Genetic) {
+  for (const RotationSweepCandidate& candidate : found.value()) start.sweepSeeds.push_back(candidate.params);
+  if (stage.search != SearchStrategy::Genetic) {  // a single-start search starts from the best (its only seed)
     current = found.value().front().params;
     start.similarity = found.value().front().similarity;
-    start.sweepSeeds = {current};
-    return Ok{};
+    start.sweepSeeds.resize(1);
   }
-  for (const RotationSweepCandidate& candidate : found.value()) start.sweepSeeds.push_back(candidate.params);
   return Ok{};
 }
 
@@ -309,8 +309,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
     return -value.value();
   };
 
-  const std::unique_ptr<PoseOptimizer> optimizer =
-      makeOptimizer(stage, stage.search == SearchStrategy::Genetic ? start.sweepSeeds : std::vector<PoseVector>{});
+  const std::unique_ptr<PoseOptimizer> optimizer = makeOptimizer(stage, start.sweepSeeds);
   auto found = optimizer->minimize(f, current, registrationCase.scales(), context.monitor);
   if (!renderError.empty()) return fail(fmt::format("stage '{}': {}", stage.name, renderError));
   if (const Status applied = applySearchOutcome(found, context.monitor, report, current); !applied) {

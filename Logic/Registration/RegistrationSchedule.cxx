@@ -66,7 +66,8 @@ void readCmaEs(const nlohmann::json& object, const std::string& where, JsonReade
 void readRotationSweep(const nlohmann::json& object, const std::string& where, JsonReader& parent,
                        RotationSweepSpec& o) {
   JsonReader reader(object, where + ": rotation_sweep");
-  o.maxRotation_deg = reader.number("max_deg");
+  if (!reader.has("max_deg")) reader.rejectKey("max_deg", "is missing; give the grid's radius in degrees, e.g. 60");
+  optionalNumber(reader, "max_deg", o.maxRotation_deg);
   optionalNumber(reader, "step_deg", o.step_deg);
   optionalInteger(reader, "aligned", 1, o.aligned);
   optionalInteger(reader, "seeds", 1, o.seeds);

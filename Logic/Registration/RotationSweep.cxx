@@ -14,7 +14,6 @@ namespace {
 struct GridPose {
   Eigen::Isometry3d T_world_from_ct;
   double similarity = 0.0;
-  double offset_deg = 0.0;
 };
 
 /// T rotated by the rotation vector `rotation_deg` (world axes) about the world point `centre_world_mm`.
@@ -54,7 +53,7 @@ Result<std::vector<RotationSweepCandidate>> RotationSweep::run(RegistrationCase&
     const Eigen::Isometry3d T = rotatedAbout(T_start, r_deg, centre_world_mm);
     auto similarity = gridObjective.similarity(T);
     if (!similarity) return fail(similarity.error());
-    grid.push_back({T, similarity.value(), r_deg.norm()});
+    grid.push_back({T, similarity.value()});
   }
   const auto better = [](const GridPose& a, const GridPose& b) { return a.similarity > b.similarity; };
   const std::size_t aligned = std::min(grid.size(), static_cast<std::size_t>(spec.aligned));
@@ -79,7 +78,7 @@ Result<std::vector<RotationSweepCandidate>> RotationSweep::run(RegistrationCase&
     if (!(pose.similarity > startSimilarity) || static_cast<int>(out.size()) >= spec.seeds) break;
     auto params = RigidPose::fromTransform(pose.T_world_from_ct, registrationCase.rotationCentre_ct_mm());
     if (!params) return fail(params.error());
-    out.push_back({params.value().asVector(), pose.similarity, pose.offset_deg});
+    out.push_back({params.value().asVector(), pose.similarity});
   }
   return out;
 }

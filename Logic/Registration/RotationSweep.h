@@ -23,7 +23,6 @@ namespace fct {
 struct RotationSweepCandidate {
   PoseVector params = PoseVector::Zero();  ///< pose parameters (deg about the bone centre, mm)
   double similarity = 0.0;                 ///< the stage's similarity there
-  double offset_deg = 0.0;                 ///< the grid rotation it came from (angle about the bone centre)
 };
 
 /// The rotation grid search of one stage.

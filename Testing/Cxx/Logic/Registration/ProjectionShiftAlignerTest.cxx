@@ -3,27 +3,13 @@
 #include <gtest/gtest.h>
 
 #include "Registration/ProjectionShiftAligner.h"
-#include "RegistrationTestCase.h"
+#include "CoarsePhantomCase.h"
 
 namespace {
 
-struct Prepared {
-  fct::test::KnownTruthCase simulated;
-  fct::RegistrationCase registrationCase;
-};
+using Prepared = fct::test::PreparedCase;
 
-/// The small phantom seen by the first `viewCount` standard views on a 128x128 detector at 2.4 mm.
-Prepared prepare(std::size_t viewCount) {
-  fct::test::KnownTruthOptions options;
-  options.cols = options.rows = 128;
-  options.pixelSpacing_mm = 2.4;
-  auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), options);
-  EXPECT_TRUE(simulated.ok()) << simulated.error();
-  simulated.value().views.resize(viewCount);
-  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {});
-  EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
-  return Prepared{std::move(simulated).value(), std::move(registrationCase).value()};
-}
+Prepared prepare(std::size_t viewCount) { return fct::test::prepareCoarsePhantom(viewCount); }
 
 /// The bone centre's distance (world mm) between two poses.
 double centreDistance_mm(const Prepared& p, const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
