@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -195,14 +196,15 @@ nlohmann::ordered_json transgraphReport(const RegistrationCase& c) {
   return report;
 }
 
-/// Each view's fraction of the field excluded as metal, for RESULT.json; printed unless --no-metal-mask.
-nlohmann::ordered_json metalReport(const Options& o, const RegistrationCase& c) {
+/// Each view's fraction of the field excluded as metal, for RESULT.json; printed unless --no-metal-mask, each line
+/// ending with `when` (e.g. " after the metal review").
+nlohmann::ordered_json metalReport(const Options& o, const RegistrationCase& c, const std::string& when = {}) {
   nlohmann::ordered_json fractions = nlohmann::ordered_json::object();
   for (std::size_t v = 0; v < c.viewCount(); ++v) {
     fractions[c.viewName(v)] = c.prepared(v).metalFraction;
     if (!o.noMetalMask) {
-      fmt::print("view {}: metal mask excludes {:.2f} % of the field\n", c.viewName(v),
-                 100.0 * c.prepared(v).metalFraction);
+      fmt::print("view {}: metal mask excludes {:.2f} % of the field{}\n", c.viewName(v),
+                 100.0 * c.prepared(v).metalFraction, when);
     }
   }
   return fractions;
@@ -412,6 +414,10 @@ int runRegister(const Options& o) {
   auto result = runRegistration(o, in, registrationCase.value(), InterruptGuard::cancelFlag(), onStageEnd);
   if (!result) return reportError(result.error());
   const RegistrationResult& r = result.value();
+  if (std::any_of(r.stages.begin(), r.stages.end(), [](const StageReport& s) { return s.metalPiecesGivenBack > 0; })) {
+    metal = metalReport(o, registrationCase.value(), " after the metal review");
+    if (Status written = writeMasks(o, registrationCase.value()); !written) return reportError(written.error());
+  }
   if (Status written = writeOverlays(o, in, caseOptions.boneThreshold_hu, r); !written) {
     return reportError(written.error());
   }
@@ -505,7 +511,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   command->add_option("--masks", options->masks,
                       "Folder for one PNG per view (<view>_mask.png): white pixels are compared with the DRR, black "
-                      "ones excluded (field border, margin, calibration spheres, metal)");
+                      "ones excluded (field border, margin, calibration spheres, metal; rewritten after a metal review)");
   command->add_flag("--no-rois", options->ablation.noDynamicRois, "Ablation: every valid pixel instead of dynamic ROIs");
   command->add_flag("--no-pyramid", options->ablation.noPyramid, "Ablation: full resolution in every stage");
   command->add_flag("--ncc-only", options->ablation.nccOnly, "Ablation: NCC in every stage (no VLNC)");

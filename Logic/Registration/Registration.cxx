@@ -237,7 +237,9 @@ struct StageStart {
   Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();  ///< the pre-alignment's move (LPS mm)
   double similarity = std::numeric_limits<double>::quiet_NaN();      ///< at the start pose; NaN: not known yet
   std::vector<PoseVector> sweepSeeds;  ///< rotation sweep poses that beat the start (deg, mm), best first
-  long sweepGridDrrs = 0;              ///< DRRs the sweep's grid ranking rendered (its own sparser objective)
+  /// DRRs rendered before the search: the metal review's and the rotation sweep's grid ranking (its own objective)
+  long preSearchDrrs = 0;
+  int metalPiecesGivenBack = 0;  ///< metal-mask pieces the metal review gave back
 };
 
 /// The stage's similarity at `current` (pose parameters), or `known` when that is not NaN. Fails, naming the stage.
@@ -265,7 +267,7 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
   if (!gridObjective) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, gridObjective.error()));
   auto found = RotationSweep::run(registrationCase, gridObjective.value(), objective, stage.rotationSweep, stage.level,
                                   current, start.similarity);
-  start.sweepGridDrrs = gridObjective.value().drrCount();
+  start.preSearchDrrs += gridObjective.value().drrCount();
   if (!found) return fail(fmt::format("stage '{}': rotation sweep: {}", stage.name, found.error()));
   if (found.value().empty()) return Ok{};
   for (const RotationSweepCandidate& candidate : found.value()) start.sweepSeeds.push_back(candidate.params);
@@ -290,6 +292,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   StageReport report = startReport(stage, startSimilarity, objective);
   report.prealignShift_world_mm = start.prealignShift_world_mm;
   report.rotationSweepSeeds = static_cast<int>(start.sweepSeeds.size());
+  report.metalPiecesGivenBack = start.metalPiecesGivenBack;
 
   RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startSimilarity);
   std::string renderError;
@@ -300,7 +303,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
       return std::numeric_limits<double>::quiet_NaN();
     }
     ++progress.iteration;
-    progress.drrs = drrsBefore + start.sweepGridDrrs + objective.drrCount();
+    progress.drrs = drrsBefore + start.preSearchDrrs + objective.drrCount();
     progress.bestSimilarity = std::max(progress.bestSimilarity, value.value());
     progress.fraction =
         (stageIndex + std::min(1.0, static_cast<double>(progress.iteration) / progress.maxIterations)) /
@@ -315,7 +318,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   if (const Status applied = applySearchOutcome(found, context.monitor, report, current); !applied) {
     return fail(fmt::format("stage '{}': {}", stage.name, applied.error()));
   }
-  report.drrs = objective.drrCount() + start.sweepGridDrrs;
+  report.drrs = objective.drrCount() + start.preSearchDrrs;
   report.fallbackRays = objective.fallbackRayCount();
   report.seconds = secondsSince(start.began);
   report.cpuSeconds = cpuSecondsSince(start.cpuBegan);
@@ -335,6 +338,10 @@ std::string stageStartNote(const StageReport& report) {
                                 report.rotationSweepSeeds == 1 ? "" : "s"));
   } else if (report.rotationSweepSeeds > 0) {
     notes.emplace_back("start moved to the rotation sweep's best pose");
+  }
+  if (report.metalPiecesGivenBack > 0) {
+    notes.push_back(fmt::format("{} metal-mask piece{} the DRR explains compared as anatomy",
+                                report.metalPiecesGivenBack, report.metalPiecesGivenBack == 1 ? "" : "s"));
   }
   return fmt::format("{}", fmt::join(notes, "; "));
 }
@@ -375,6 +382,19 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
     const auto i = static_cast<std::size_t>(s);
     const RegistrationStage& stage = schedule.stages[i];
     StageStart stageStart;
+    if (stage.metalReview) {
+      const Eigen::Isometry3d T_review = registrationCase.poseTransform(current);
+      auto review = registrationCase.reviewMetalMasks(T_review);
+      if (!review) return fail(fmt::format("stage '{}': {}", stage.name, review.error()));
+      stageStart.metalPiecesGivenBack = review.value().piecesGivenBack;
+      stageStart.preSearchDrrs += review.value().drrs;
+      // The masks changed: the objectives from this stage on select their pixels again.
+      for (std::size_t j = i; j < schedule.stages.size() && review.value().piecesGivenBack > 0; ++j) {
+        auto rebuilt = objectiveAt(registrationCase, schedule.stages[j], options.ablation, useViewRenderers, T_review);
+        if (!rebuilt) return fail(rebuilt.error());
+        objectives.value()[j] = std::move(rebuilt).value();
+      }
+    }
     if (stage.shiftPrealign) {
       auto outcome = prealignByShift(registrationCase, stage, objectives.value()[i], current);
       if (!outcome) return fail(outcome.error());

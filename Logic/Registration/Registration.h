@@ -66,6 +66,8 @@ struct StageReport {
   Eigen::Vector3d prealignShift_world_mm = Eigen::Vector3d::Zero();
   /// Poses of its rotation sweep that beat the start: refined beside it (genetic), or the start moved to the best (1).
   int rotationSweepSeeds = 0;
+  /// Metal-mask pieces its metal review gave back to the comparison as anatomy (0 without a review or when none).
+  int metalPiecesGivenBack = 0;
   bool cancelled = false;
   Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the stage's final pose (LPS mm)
 };

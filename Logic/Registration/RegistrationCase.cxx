@@ -10,6 +10,7 @@
 #include "Drr/CutFaceRayMask.h"
 #include "Geometry/RigidPose.h"
 #include "Search/PoseOptimizer.h"
+#include "XrayPrep/MetalMaskReview.h"
 
 namespace fct {
 
@@ -130,6 +131,35 @@ Status RegistrationCase::replaceXray(std::size_t v, const XrayImage& xray) {
   view.prepared = std::move(prepared).value();
   view.selectors.clear();
   return Ok{};
+}
+
+Result<MetalReviewSummary> RegistrationCase::reviewMetalMasks(const Eigen::Isometry3d& T_world_from_ct) {
+  MetalReviewSummary summary;
+  auto cutFaces = CutFaceRayMask::create(*m_drrVolume, kMetalReviewCutFaceMargin_mm);
+  if (!cutFaces) return fail("metal mask review: " + cutFaces.error());
+  for (View& view : m_views) {
+    if (!view.preparation.excludeMetal || !(view.prepared.metalFraction > 0.0)) continue;
+    auto drr = m_renderer->render(view.camera, T_world_from_ct, 0);
+    if (!drr) return fail(fmt::format("view '{}': metal mask review: {}", view.name, drr.error()));
+    ++summary.drrs;
+    const PyramidLevel& full = view.prepared.pyramid.level(0);
+    auto reviewed = MetalMaskReview(view.preparation.metal)
+                        .review(view.prepared.fieldMask, full.mask, full.image, drr.value(),
+                                cutFaces.value().compute(view.camera, T_world_from_ct),
+                                view.camera.intrinsics().pixelSpacing_mm.mean());
+    if (!reviewed) return fail(fmt::format("view '{}': {}", view.name, reviewed.error()));
+    if (reviewed.value().piecesGivenBack == 0) continue;
+    auto pyramid = XrayPyramid::build(full.image, reviewed.value().mask, view.camera, levelCount());
+    if (!pyramid) return fail(fmt::format("view '{}': metal mask review: pyramid: {}", view.name, pyramid.error()));
+    const ValidMask& mask = reviewed.value().mask;
+    view.prepared.metalFraction = static_cast<double>(reviewed.value().metalPixelCount) /
+                                  static_cast<double>(view.prepared.fieldMask.validCount());
+    view.prepared.validFraction = static_cast<double>(mask.validCount()) / static_cast<double>(mask.valid.size());
+    view.prepared.pyramid = std::move(pyramid).value();
+    view.selectors.clear();
+    summary.piecesGivenBack += reviewed.value().piecesGivenBack;
+  }
+  return summary;
 }
 
 Status RegistrationCase::prepareViewRenderers(const Eigen::Isometry3d& T_expected_world_from_ct,

@@ -54,6 +54,12 @@ struct RegistrationCaseOptions {
   std::optional<Eigen::Isometry3d> T_expected_world_from_ct;
 };
 
+/// What RegistrationCase::reviewMetalMasks did.
+struct MetalReviewSummary {
+  int piecesGivenBack = 0;  ///< metal-mask pieces given back as anatomy, all views
+  int drrs = 0;           ///< full-resolution DRRs rendered (one per view with metal)
+};
+
 /// A prepared registration problem: CT, renderer and views.
 class RegistrationCase {
  public:
@@ -116,6 +122,15 @@ class RegistrationCase {
   /// Transgraph tables and bone surface stay. Fails, naming the view and leaving it as it was, on a bad index, an
   /// image of another size than the view's detector, a failed preparation, or an X-ray constant over its valid pixels.
   Status replaceXray(std::size_t v, const XrayImage& xray);
+  /// Gives back to the comparison the metal-mask pieces of every view that a DRR of the CT at T_world_from_ct (a pose
+  /// near the truth, e.g. after the global stage) explains: anatomy the detector took for metal (MetalMaskReview).
+  /// A view that changes gets its pyramid rebuilt, its metal fraction updated and its ROI statistics dropped. Returns
+  /// the pieces given back (0: nothing changed) and the DRRs rendered (one per view with metal). Fails, naming the view
+  /// and leaving it as it was, when its DRR cannot be rendered or the review fails.
+  Result<MetalReviewSummary> reviewMetalMasks(const Eigen::Isometry3d& T_world_from_ct);
+  /// Rays passing within this distance of the CT's cut faces (mm) are not judged by the metal review: beyond them the
+  /// X-ray shows anatomy the DRR lacks.
+  static constexpr double kMetalReviewCutFaceMargin_mm = 5.0;
   /// The full-resolution camera of view v.
   const Camera& camera(std::size_t v) const { return m_views[v].camera; }
   /// Number of pyramid levels of every view.

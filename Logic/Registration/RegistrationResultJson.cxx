@@ -106,6 +106,9 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
   }
   if (reader.has("prealign_shift_mm")) stage.prealignShift_world_mm = reader.vector("prealign_shift_mm", 3);
   if (reader.has("rotation_sweep_seeds")) stage.rotationSweepSeeds = reader.integer("rotation_sweep_seeds", 0);
+  if (reader.has("metal_pieces_given_back")) {
+    stage.metalPiecesGivenBack = reader.integer("metal_pieces_given_back", 0);
+  }
   stage.cancelled = reader.boolean("cancelled");
   parent.adoptError(reader);
   return stage;
@@ -136,6 +139,7 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
       stages.back()["prealign_shift_mm"] = JsonDocument::array(s.prealignShift_world_mm);
     }
     if (s.rotationSweepSeeds > 0) stages.back()["rotation_sweep_seeds"] = s.rotationSweepSeeds;
+    if (s.metalPiecesGivenBack > 0) stages.back()["metal_pieces_given_back"] = s.metalPiecesGivenBack;
   }
   ordered_json initialPose = ordered_json::object();
   initialPose["T_world_from_ct"] = JsonDocument::array(result.T_initial.matrix());

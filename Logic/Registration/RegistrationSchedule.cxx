@@ -105,6 +105,7 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
   optionalFlag(reader, "exact_drr", stage.exactDrr);
   optionalFlag(reader, "shift_prealign", stage.shiftPrealign);
+  optionalFlag(reader, "metal_review", stage.metalReview);
   if (const nlohmann::json* sweep = reader.find("rotation_sweep")) readRotationSweep(*sweep, where, reader, stage.rotationSweep);
   if (reader.has("drr")) stage.drrMethod = parseName(reader, "drr", kStageDrrMethods);
   optionalNumber(reader, "drr_step_voxels", stage.drrStep_voxels);
@@ -285,6 +286,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
     if (s.shiftPrealign) stageJson["shift_prealign"] = true;
+    if (s.metalReview) stageJson["metal_review"] = true;
     if (s.rotationSweep.maxRotation_deg > 0.0) {
       stageJson["rotation_sweep"] = {{"max_deg", s.rotationSweep.maxRotation_deg},
                                      {"step_deg", s.rotationSweep.step_deg},

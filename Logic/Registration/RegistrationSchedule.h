@@ -71,6 +71,9 @@ struct RegistrationStage {
   /// stage's level (ProjectionShiftAligner), when that raises the stage's similarity: a far start's DRR then overlaps
   /// its X-ray before the search looks around it.
   bool shiftPrealign = false;
+  /// Before the stage, give back the metal-mask pieces that a DRR at the stage's start explains (anatomy taken for
+  /// metal, RegistrationCase::reviewMetalMasks); for a stage that starts near the truth, after the global search.
+  bool metalReview = false;
   /// Before the search (after the shift pre-alignment), look around the start's rotation on a coarse grid; the poses
   /// that beat the start are refined beside it (genetic) or replace it (local, CMA-ES: the best one).
   RotationSweepSpec rotationSweep;

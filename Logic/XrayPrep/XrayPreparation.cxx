@@ -47,6 +47,7 @@ Result<PreparedXray> XrayPreparation::prepare(const XrayImage& xray) const {
   if (!lineIntegrals) return fail("intensity model: " + lineIntegrals.error());
   prepared.referenceIntensity = lineIntegrals.value().referenceIntensity;
 
+  prepared.fieldMask = mask;
   if (o.excludeMetal) {
     const std::size_t fieldCount = mask.validCount();
     const double pixelSpacing_mm = xray.camera ? xray.camera->intrinsics().pixelSpacing_mm.mean() : 0.0;

@@ -40,6 +40,9 @@ struct PreparedXray {
   double referenceIntensity = 0.0;         ///< I0 of the log transform, in the input's intensity units
   double validFraction = 0.0;              ///< fraction of level-0 pixels valid
   double metalFraction = 0.0;              ///< fraction of the otherwise valid level-0 pixels excluded as metal
+  /// Level-0 valid pixels before the metal exclusion (field of view, margin, spheres): what a metal-mask review
+  /// (MetalMaskReview) may give back.
+  ValidMask fieldMask;
 };
 
 /// Prepares X-ray views for registration.

@@ -4,8 +4,10 @@
 // whole-image NCC and the dynamic ROIs away.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "Registration/Registration.h"
 #include "RegistrationTestCase.h"
@@ -39,40 +41,59 @@ void addKWires(fct::test::KnownTruthCase& c, const std::vector<std::pair<Eigen::
   }
 }
 
-/// Mean bone-surface error in mm after a fast-preset registration from 10 mm, with or without the metal mask.
-double errorAfterRegistration(bool excludeMetal) {
+/// Two K-wires through the bone near the world origin (the bone centre and the views' isocentre): world segments, mm.
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> kWires() {
+  return {{Eigen::Vector3d(-60.0, -40.0, -30.0), Eigen::Vector3d(50.0, 30.0, 35.0)},
+          {Eigen::Vector3d(-30.0, 50.0, 40.0), Eigen::Vector3d(40.0, -45.0, -20.0)}};
+}
+
+/// The phantom case with the two K-wires burnt into its views, prepared with or without the metal mask.
+struct KWireCase {
+  fct::test::KnownTruthCase truth;
+  fct::RegistrationCase registrationCase;
+};
+
+KWireCase prepareKWireCase(bool excludeMetal) {
   fct::PhantomOptions phantom;
   phantom.dims = Eigen::Vector3i(80, 80, 60);
   phantom.spacing_mm = 2.0;
   auto simulated = fct::test::simulateCase(fct::PhantomBuilder::build(phantom).value());
   EXPECT_TRUE(simulated.ok()) << simulated.error();
-  if (!simulated) return 1e9;
   fct::test::KnownTruthCase c = std::move(simulated).value();
-  // Two wires through the bone near the world origin (the bone centre and the views' isocentre).
-  addKWires(c, {{Eigen::Vector3d(-60.0, -40.0, -30.0), Eigen::Vector3d(50.0, 30.0, 35.0)},
-                {Eigen::Vector3d(-30.0, 50.0, 40.0), Eigen::Vector3d(40.0, -45.0, -20.0)}});
+  addKWires(c, kWires());
   fct::RegistrationCaseOptions caseOptions;
   caseOptions.preparation.excludeMetal = excludeMetal;
   auto registrationCase = fct::RegistrationCase::create(c.ct, c.views, caseOptions);
   EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
-  if (!registrationCase) return 1e9;
-  fct::RegistrationCase& rc = registrationCase.value();
+  return KWireCase{std::move(c), std::move(registrationCase).value()};
+}
+
+/// Mean bone-surface error in mm after a fast-preset registration from 10 mm, with or without the metal mask, and
+/// with or without a metal review before its second stage.
+double errorAfterRegistration(bool excludeMetal, bool metalReview = false) {
+  KWireCase k = prepareKWireCase(excludeMetal);
+  fct::RegistrationCase& rc = k.registrationCase;
   for (std::size_t v = 0; v < rc.viewCount(); ++v) {
     std::printf("view %s: metal fraction %.2f %%\n", rc.viewName(v).c_str(), 100.0 * rc.prepared(v).metalFraction);
     if (excludeMetal) {
       EXPECT_GT(rc.prepared(v).metalFraction, 0.005) << rc.viewName(v);
     }
   }
-  const Eigen::Isometry3d start = fct::test::startPose(rc, c.T_truth, 10.0, 1000);
+  const Eigen::Isometry3d start = fct::test::startPose(rc, k.truth.T_truth, 10.0, 1000);
   fct::RegistrationOptions options;
   options.schedule = fct::RegistrationSchedule::builtin("fast").value();
+  if (metalReview) options.schedule.stages.at(1).metalReview = true;
   options.seed = 1000;
   auto result = fct::Registration::run(rc, start, options);
   EXPECT_TRUE(result.ok()) << result.error();
   if (!result) return 1e9;
-  const double error = rc.bone()->meanDistance_mm(result.value().T_world_from_ct, c.T_truth);
-  std::printf("metal mask %s: error %.3f mm after %ld DRRs\n", excludeMetal ? "on" : "off", error,
-              result.value().totalDrrs);
+  const double error = rc.bone()->meanDistance_mm(result.value().T_world_from_ct, k.truth.T_truth);
+  std::printf("metal mask %s%s: error %.3f mm after %ld DRRs\n", excludeMetal ? "on" : "off",
+              metalReview ? " with review" : "", error, result.value().totalDrrs);
+  if (metalReview) {
+    EXPECT_EQ(result.value().stages.at(1).metalPiecesGivenBack, 0) << "the K-wires are not in the CT";
+    for (std::size_t v = 0; v < rc.viewCount(); ++v) EXPECT_GT(rc.prepared(v).metalFraction, 0.005) << rc.viewName(v);
+  }
   return error;
 }
 
@@ -84,4 +105,62 @@ TEST(MetalRegistration, PhantomWithKWiresConvergesWithMetalMask) {
 
 TEST(MetalRegistration, PhantomWithKWiresFailsWithoutMetalMask) {
   EXPECT_GT(errorAfterRegistration(false), 0.5);
+}
+
+TEST(MetalRegistration, MetalReviewKeepsTheKWiresMaskedAndConverges) {
+  EXPECT_LT(errorAfterRegistration(true, true), 0.5);
+}
+
+TEST(MetalRegistration, MetalReviewComparesMetalTheCtHolds) {
+  // At the truth the review keeps the K-wires, which the CT lacks, out.
+  KWireCase k = prepareKWireCase(true);
+  fct::RegistrationCase& rc = k.registrationCase;
+  std::vector<double> before;
+  for (std::size_t v = 0; v < rc.viewCount(); ++v) before.push_back(rc.prepared(v).metalFraction);
+  auto unchanged = rc.reviewMetalMasks(k.truth.T_truth);
+  ASSERT_TRUE(unchanged.ok()) << unchanged.error();
+  EXPECT_EQ(unchanged.value().piecesGivenBack, 0);
+  EXPECT_EQ(unchanged.value().drrs, static_cast<int>(rc.viewCount()));
+  for (std::size_t v = 0; v < rc.viewCount(); ++v) EXPECT_DOUBLE_EQ(rc.prepared(v).metalFraction, before[v]);
+
+  // Steel-dense rods in the CT itself (an implant already there before surgery): the detector takes their shadows for
+  // tools, the DRR explains them, and the review gives them back.
+  fct::PhantomOptions phantom;
+  phantom.dims = Eigen::Vector3i(80, 80, 60);
+  phantom.spacing_mm = 2.0;
+  fct::Volume ct = fct::PhantomBuilder::build(phantom).value();
+  const Eigen::Vector3d c_ct_mm = ct.centre_lps_mm();
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rods_ct_mm = {
+      {c_ct_mm + Eigen::Vector3d(-50.0, -30.0, -25.0), c_ct_mm + Eigen::Vector3d(45.0, 25.0, 30.0)},
+      {c_ct_mm + Eigen::Vector3d(-25.0, 45.0, 30.0), c_ct_mm + Eigen::Vector3d(35.0, -40.0, -15.0)}};
+  for (const auto& [a_ct_mm, b_ct_mm] : rods_ct_mm) {
+    const Eigen::Vector3d ab = b_ct_mm - a_ct_mm;
+    for (int z = 0; z < ct.dims().z(); ++z) {
+      for (int y = 0; y < ct.dims().y(); ++y) {
+        for (int x = 0; x < ct.dims().x(); ++x) {
+          const Eigen::Vector3d p_ct_mm = ct.lpsFromIjk(Eigen::Vector3d(x, y, z));
+          const double t = std::clamp((p_ct_mm - a_ct_mm).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+          if ((p_ct_mm - (a_ct_mm + t * ab)).norm() <= 2.0) ct.at(x, y, z) = 60000.0f;  // a steel rod's attenuation
+        }
+      }
+    }
+  }
+  auto simulated = fct::test::simulateCase(ct);
+  ASSERT_TRUE(simulated.ok()) << simulated.error();
+  auto withRods = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views);
+  ASSERT_TRUE(withRods.ok()) << withRods.error();
+  std::vector<double> rodsBefore;
+  for (std::size_t v = 0; v < withRods.value().viewCount(); ++v) {
+    rodsBefore.push_back(withRods.value().prepared(v).metalFraction);
+    EXPECT_GT(rodsBefore.back(), 0.005) << "the rods look like tools to the detector";
+  }
+  auto reviewed = withRods.value().reviewMetalMasks(simulated.value().T_truth);
+  ASSERT_TRUE(reviewed.ok()) << reviewed.error();
+  EXPECT_GE(reviewed.value().piecesGivenBack, 1);
+  for (std::size_t v = 0; v < withRods.value().viewCount(); ++v) {
+    const double after = withRods.value().prepared(v).metalFraction;
+    std::printf("rods in the CT, view %s: metal fraction %.2f %% -> %.2f %%\n", withRods.value().viewName(v).c_str(),
+                100.0 * rodsBefore[v], 100.0 * after);
+    EXPECT_LT(after, 0.25 * rodsBefore[v]) << withRods.value().viewName(v);
+  }
 }

@@ -57,6 +57,7 @@ fct::RegistrationResult fullResult() {
   stage.keptFraction = {0.125, 0.0625};
   stage.prealignShift_world_mm = {12.5, -3.25, 0.5};
   stage.rotationSweepSeeds = 2;
+  stage.metalPiecesGivenBack = 3;
   r.stages = {stage};
   r.totalSeconds = 7.5;
   r.totalDrrs = 4000;
@@ -103,6 +104,7 @@ TEST(RegistrationResultJson, WritesEveryStageWithKeptFractionsByViewName) {
   EXPECT_EQ(stages[1]["kept_fraction"].size(), 2u) << "a fraction without a view name is left out";
   EXPECT_FALSE(stages[0].contains("prealign_shift_mm")) << "written only for a stage whose start it moved";
   EXPECT_FALSE(stages[0].contains("rotation_sweep_seeds")) << "written only for a stage its rotation sweep seeded";
+  EXPECT_FALSE(stages[0].contains("metal_pieces_given_back")) << "written only for a stage whose metal review gave back";
 }
 
 TEST(RegistrationResultJson, NoStageGivesAnEmptyArray) {
@@ -145,6 +147,7 @@ TEST(RegistrationResultJson, WriteThenReadGivesTheSameResult) {
   EXPECT_EQ(s.keptFraction, a.stages[0].keptFraction);
   EXPECT_EQ(s.prealignShift_world_mm, a.stages[0].prealignShift_world_mm);
   EXPECT_EQ(s.rotationSweepSeeds, a.stages[0].rotationSweepSeeds);
+  EXPECT_EQ(s.metalPiecesGivenBack, 3);
   EXPECT_FALSE(s.cancelled);
   EXPECT_EQ(b.totalSeconds, 7.5);
   EXPECT_EQ(b.totalDrrs, 4000);

@@ -40,6 +40,9 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
   EXPECT_GT(s[0].pixels.maxPixels, 0) << "the global stage samples its level sparsely";
   EXPECT_TRUE(s[0].shiftPrealign) << "a far start is first lined up in 2D";
   EXPECT_GE(s[0].rotationSweep.maxRotation_deg, 45.0) << "and looked around on a grid of rotations";
+  EXPECT_FALSE(s[0].metalReview);
+  EXPECT_TRUE(s[1].metalReview) << "the first stage after the global search reviews the metal masks";
+  EXPECT_FALSE(s[2].metalReview);
   for (std::size_t i = 1; i < s.size(); ++i) {
     EXPECT_FALSE(s[i].shiftPrealign);
     EXPECT_EQ(s[i].rotationSweep.maxRotation_deg, 0.0);
@@ -116,6 +119,8 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
        "drr"},
       {stageHead + R"("metric": "ncc", "level": 2, "shift_prealign": 1, "pixels": {"set": "whole"}, )" + search + "]}",
        "shift_prealign"},
+      {stageHead + R"("metric": "vlnc", "level": 2, "metal_review": "on", "pixels": {"set": "whole"}, )" + search + "]}",
+       "metal_review"},
       {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"step_deg": 10}, "pixels": {"set": "whole"}, )" +
            search + "]}",
        "max_deg"},
