@@ -388,11 +388,13 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       if (!review) return fail(fmt::format("stage '{}': {}", stage.name, review.error()));
       stageStart.metalPiecesGivenBack = review.value().piecesGivenBack;
       stageStart.preSearchDrrs += review.value().drrs;
-      // The masks changed: the objectives from this stage on select their pixels again.
-      for (std::size_t j = i; j < schedule.stages.size() && review.value().piecesGivenBack > 0; ++j) {
-        auto rebuilt = objectiveAt(registrationCase, schedule.stages[j], options.ablation, useViewRenderers, T_review);
-        if (!rebuilt) return fail(rebuilt.error());
-        objectives.value()[j] = std::move(rebuilt).value();
+      if (review.value().piecesGivenBack > 0) {  // the masks changed: the stages from here on select their pixels again
+        for (std::size_t j = i; j < schedule.stages.size(); ++j) {
+          auto rebuilt =
+              objectiveAt(registrationCase, schedule.stages[j], options.ablation, useViewRenderers, T_review);
+          if (!rebuilt) return fail(rebuilt.error());
+          objectives.value()[j] = std::move(rebuilt).value();
+        }
       }
     }
     if (stage.shiftPrealign) {

@@ -57,7 +57,7 @@ struct RegistrationCaseOptions {
 /// What RegistrationCase::reviewMetalMasks did.
 struct MetalReviewSummary {
   int piecesGivenBack = 0;  ///< metal-mask pieces given back as anatomy, all views
-  int drrs = 0;           ///< full-resolution DRRs rendered (one per view with metal)
+  int drrs = 0;             ///< full-resolution DRRs rendered (one per view with metal)
 };
 
 /// A prepared registration problem: CT, renderer and views.

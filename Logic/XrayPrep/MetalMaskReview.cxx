@@ -12,6 +12,13 @@ namespace fct {
 
 namespace {
 
+/// The median of `values` (reordered; not empty).
+float medianOf(std::vector<float>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
 /// The DRR times the median ratio X-ray / DRR over the pixels valid in `mask` where the DRR is above a quarter of its
 /// largest value there; the DRR itself when no such pixel has a positive ratio.
 FloatImage atXrayScale(const FloatImage& drr, const FloatImage& xray, const ValidMask& mask) {
@@ -27,9 +34,8 @@ FloatImage atXrayScale(const FloatImage& drr, const FloatImage& xray, const Vali
   }
   FloatImage scaled = drr;
   if (ratios.empty() || !(largest > 0.0f)) return scaled;
-  const auto middle = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
-  std::nth_element(ratios.begin(), middle, ratios.end());
-  for (float& value : scaled.pixels) value *= *middle;
+  const float gain = medianOf(ratios);
+  for (float& value : scaled.pixels) value *= gain;
   return scaled;
 }
 
@@ -75,11 +81,6 @@ Result<MetalMaskReviewOutcome> MetalMaskReview::review(const ValidMask& fieldMas
     const cv::Mat widthElement = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(width_px, width_px));
     const cv::Mat ringElement =
         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * ring_px + 1, 2 * ring_px + 1));
-    const auto median = [](std::vector<float>& values) {
-      const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-      std::nth_element(values.begin(), middle, values.end());
-      return *middle;
-    };
     for (int label = 1; label < labelCount; ++label) {
       // The piece and its ring, within the piece's box grown by the ring's width.
       const cv::Rect box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
@@ -89,17 +90,21 @@ Result<MetalMaskReviewOutcome> MetalMaskReview::review(const ValidMask& fieldMas
       const cv::Mat piece = labels(around) == label;
       cv::Mat ring;
       cv::dilate(piece, ring, ringElement);
-      std::vector<std::size_t> pieceCovered;
+      // Linear index in the image of pixel (x, y) of the box.
+      const auto indexOf = [&around, cols](int x, int y) {
+        return static_cast<std::size_t>(around.y + y) * static_cast<std::size_t>(cols) +
+               static_cast<std::size_t>(around.x + x);
+      };
+      std::vector<cv::Point> pieceCovered;
       std::vector<float> ringXray, ringResidual;
       std::size_t piecePixels = 0;
       for (int y = 0; y < around.height; ++y) {
         for (int x = 0; x < around.width; ++x) {
-          const auto i = static_cast<std::size_t>(around.y + y) * static_cast<std::size_t>(cols) +
-                         static_cast<std::size_t>(around.x + x);
+          const std::size_t i = indexOf(x, y);
           const bool covered = coveredMask.valid[i] && drr.pixels[i] > kCoveredLineIntegral;
           if (piece.at<std::uint8_t>(y, x)) {
             ++piecePixels;
-            if (covered) pieceCovered.push_back(i);
+            if (covered) pieceCovered.emplace_back(x, y);
           } else if (ring.at<std::uint8_t>(y, x) && covered && xrayMask.valid[i]) {
             ringXray.push_back(xrayLineIntegrals.pixels[i]);
             ringResidual.push_back(xrayLineIntegrals.pixels[i] - drr.pixels[i]);
@@ -112,16 +117,16 @@ Result<MetalMaskReviewOutcome> MetalMaskReview::review(const ValidMask& fieldMas
       bool anatomy = false;
       if (!ringXray.empty() &&
           static_cast<double>(pieceCovered.size()) >= kMinCovered * static_cast<double>(piecePixels)) {
-        const float ringLevel = median(ringXray);
-        const float ringResidualLevel = median(ringResidual);
+        const float ringLevel = medianOf(ringXray);
+        const float ringResidualLevel = medianOf(ringResidual);
         cv::Mat unexplained = cv::Mat::zeros(around.size(), CV_8U);
         bool core = false;
-        for (const std::size_t i : pieceCovered) {
+        for (const cv::Point& pixel : pieceCovered) {
+          const std::size_t i = indexOf(pixel.x, pixel.y);
           if (xrayLineIntegrals.pixels[i] - ringLevel <= standOut) continue;
           core = true;
           if (xrayLineIntegrals.pixels[i] - drr.pixels[i] - ringResidualLevel > standOut) {
-            unexplained.at<std::uint8_t>(static_cast<int>(i / static_cast<std::size_t>(cols)) - around.y,
-                                         static_cast<int>(i % static_cast<std::size_t>(cols)) - around.x) = 1;
+            unexplained.at<std::uint8_t>(pixel) = 1;
           }
         }
         // Slivers thinner than kMinUnexplainedWidth_mm (a bone edge a pixel or two off) are not a tool's shadow.
@@ -138,10 +143,8 @@ Result<MetalMaskReviewOutcome> MetalMaskReview::review(const ValidMask& fieldMas
       for (int y = 0; y < around.height; ++y) {
         for (int x = 0; x < around.width; ++x) {
           if (!piece.at<std::uint8_t>(y, x)) continue;
-          const auto i = static_cast<std::size_t>(around.y + y) * static_cast<std::size_t>(cols) +
-                         static_cast<std::size_t>(around.x + x);
           if (anatomy) {
-            outcome.mask.valid[i] = 1;
+            outcome.mask.valid[indexOf(x, y)] = 1;
           } else {
             ++outcome.metalPixelCount;
           }

@@ -15,11 +15,13 @@
 
 namespace {
 
-/// Distance in pixels from `uv` to the segment a-b.
-double distanceToSegment(const Eigen::Vector2d& uv, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double t = std::clamp((uv - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-  return (uv - (a + t * ab)).norm();
+/// Distance from `p` to the segment a-b (pixels in 2D, mm in 3D).
+template <int N>
+double distanceToSegment(const Eigen::Matrix<double, N, 1>& p, const Eigen::Matrix<double, N, 1>& a,
+                         const Eigen::Matrix<double, N, 1>& b) {
+  const Eigen::Matrix<double, N, 1> ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
 }
 
 /// Burns K-wires (world segments) into every view's intensities: I *= exp(-wireLineIntegral) within 2 px.
@@ -134,13 +136,11 @@ TEST(MetalRegistration, MetalReviewComparesMetalTheCtHolds) {
       {c_ct_mm + Eigen::Vector3d(-50.0, -30.0, -25.0), c_ct_mm + Eigen::Vector3d(45.0, 25.0, 30.0)},
       {c_ct_mm + Eigen::Vector3d(-25.0, 45.0, 30.0), c_ct_mm + Eigen::Vector3d(35.0, -40.0, -15.0)}};
   for (const auto& [a_ct_mm, b_ct_mm] : rods_ct_mm) {
-    const Eigen::Vector3d ab = b_ct_mm - a_ct_mm;
     for (int z = 0; z < ct.dims().z(); ++z) {
       for (int y = 0; y < ct.dims().y(); ++y) {
         for (int x = 0; x < ct.dims().x(); ++x) {
           const Eigen::Vector3d p_ct_mm = ct.lpsFromIjk(Eigen::Vector3d(x, y, z));
-          const double t = std::clamp((p_ct_mm - a_ct_mm).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-          if ((p_ct_mm - (a_ct_mm + t * ab)).norm() <= 2.0) ct.at(x, y, z) = 60000.0f;  // a steel rod's attenuation
+          if (distanceToSegment(p_ct_mm, a_ct_mm, b_ct_mm) <= 2.0) ct.at(x, y, z) = 60000.0f;  // a steel rod
         }
       }
     }
