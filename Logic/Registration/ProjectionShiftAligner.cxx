@@ -7,6 +7,8 @@
 #include <cmath>
 #include <optional>
 
+#include "XrayPrep/XrayPyramid.h"
+
 namespace fct {
 
 namespace {
@@ -122,7 +124,8 @@ Eigen::Vector3d triangulateTranslation(const std::vector<Camera>& cameras, const
 
 Result<ShiftAlignment> ProjectionShiftAligner::align(RegistrationCase& registrationCase,
                                                      const Eigen::Isometry3d& T_world_from_ct, int level,
-                                                     double maxShiftFraction, double minPeakCorrelation) {
+                                                     double maxShiftFraction, double minPeakCorrelation,
+                                                     int coarsening) {
   if (level < 0 || level >= registrationCase.levelCount()) {
     return fail(fmt::format("shift alignment level {} is not one of the pyramid's levels 0 to {}", level,
                             registrationCase.levelCount() - 1));
@@ -130,19 +133,36 @@ Result<ShiftAlignment> ProjectionShiftAligner::align(RegistrationCase& registrat
   if (!(maxShiftFraction > 0.0 && maxShiftFraction <= 1.0)) {
     return fail(fmt::format("shift alignment range must be a fraction of the image in (0, 1], got {}", maxShiftFraction));
   }
+  if (coarsening < 0 || coarsening > 3) {
+    return fail(fmt::format("shift alignment coarsening must be 0 to 3 halvings, got {}", coarsening));
+  }
   ShiftAlignment out;
   out.T_world_from_ct = T_world_from_ct;
   const Eigen::Vector3d centre_world_mm = T_world_from_ct * registrationCase.rotationCentre_ct_mm();
-  const double levelScale = std::ldexp(1.0, level);
+  const int matchLevel = level + coarsening;
+  const double levelScale = std::ldexp(1.0, matchLevel);
   std::vector<Camera> cameras;
   std::vector<Eigen::Vector2d> targets;
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
     const PyramidLevel& xray = registrationCase.prepared(v).pyramid.level(level);
+    FloatImage coarseImage;
+    ValidMask coarseMask;
+    for (int k = 0; k < coarsening; ++k) {
+      coarseImage = XrayPyramid::downsampleByTwo(k == 0 ? xray.image : coarseImage);
+      coarseMask = XrayPyramid::downsampleByTwo(k == 0 ? xray.mask : coarseMask);
+    }
+    const FloatImage& xrayImage = coarsening > 0 ? coarseImage : xray.image;
+    const ValidMask& xrayMask = coarsening > 0 ? coarseMask : xray.mask;
     auto renderer = registrationCase.levelRenderer(v, level, T_world_from_ct);
     if (!renderer) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), renderer.error()));
-    auto drr = renderer.value()->render(registrationCase.camera(v), T_world_from_ct, level);
+    auto drr = renderer.value()->render(registrationCase.camera(v), T_world_from_ct, matchLevel);
     if (!drr) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), drr.error()));
-    const std::optional<LevelShift> shift = bestShift(drr.value(), xray.image, xray.mask, maxShiftFraction);
+    if (drr.value().cols != xrayImage.cols || drr.value().rows != xrayImage.rows) {
+      return fail(fmt::format("view '{}': the {}x{} DRR of the coarsened level does not match its {}x{} X-ray",
+                              registrationCase.viewName(v), drr.value().cols, drr.value().rows, xrayImage.cols,
+                              xrayImage.rows));
+    }
+    const std::optional<LevelShift> shift = bestShift(drr.value(), xrayImage, xrayMask, maxShiftFraction);
     out.shift_px.push_back(shift ? Eigen::Vector2d(levelScale * shift->shift_px) : Eigen::Vector2d::Zero());
     out.peakCorrelation.push_back(shift ? shift->correlation : 0.0);
     if (!shift || shift->correlation < minPeakCorrelation) continue;

@@ -29,10 +29,13 @@ class ProjectionShiftAligner {
  public:
   /// The alignment of `registrationCase`'s views at pyramid `level` from the pose T_world_from_ct, searching shifts up to
   /// `maxShiftFraction` (0..1) of each image's width and height. Views whose peak correlation is below
-  /// `minPeakCorrelation` do not vote; with no voting view the pose is returned unmoved. Fails on a bad level or
-  /// fraction, or a rendering error (naming the view).
+  /// `minPeakCorrelation` do not vote; with no voting view the pose is returned unmoved. With `coarsening` k > 0 the
+  /// images are matched at 2^k times the level's pixel size (the level's DRR renderer on a coarser detector, the X-ray
+  /// halved k times): 4^k times fewer rays, for a rough alignment. Fails on a bad level, fraction or coarsening (0..3),
+  /// or a rendering error (naming the view).
   static Result<ShiftAlignment> align(RegistrationCase& registrationCase, const Eigen::Isometry3d& T_world_from_ct,
-                                      int level, double maxShiftFraction = 0.5, double minPeakCorrelation = 0.2);
+                                      int level, double maxShiftFraction = 0.5, double minPeakCorrelation = 0.2,
+                                      int coarsening = 0);
 };
 
 }  // namespace fct

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
+
+#include <tbb/parallel_for.h>
 
 #include "Geometry/RigidPose.h"
 #include "Registration/ProjectionShiftAligner.h"
@@ -41,6 +45,19 @@ std::vector<Eigen::Vector3d> RotationSweep::offsets_deg(double max_deg, double s
   return out;
 }
 
+int RotationSweep::roughAlignmentHalvings(const RegistrationCase& registrationCase, int level) {
+  int shorterSide_px = std::numeric_limits<int>::max();
+  for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) {
+    const FloatImage& image = registrationCase.prepared(v).pyramid.level(level).image;
+    shorterSide_px = std::min({shorterSide_px, image.cols, image.rows});
+  }
+  int halvings = 0;
+  while (halvings < kRoughAlignmentMaxHalvings && (shorterSide_px >> (halvings + 1)) >= kRoughAlignmentMinSide_px) {
+    ++halvings;
+  }
+  return halvings;
+}
+
 Result<std::vector<RotationSweepCandidate>> RotationSweep::run(RegistrationCase& registrationCase,
                                                                RegistrationObjective& gridObjective,
                                                                RegistrationObjective& objective,
@@ -48,9 +65,26 @@ Result<std::vector<RotationSweepCandidate>> RotationSweep::run(RegistrationCase&
                                                                const PoseVector& start, double startSimilarity) {
   const Eigen::Isometry3d T_start = registrationCase.poseTransform(start);
   const Eigen::Vector3d centre_world_mm = T_start * registrationCase.rotationCentre_ct_mm();
-  std::vector<GridPose> grid;
+  std::vector<Eigen::Isometry3d> rotated;
   for (const Eigen::Vector3d& r_deg : offsets_deg(spec.maxRotation_deg, spec.step_deg)) {
-    const Eigen::Isometry3d T = rotatedAbout(T_start, r_deg, centre_world_mm);
+    rotated.push_back(rotatedAbout(T_start, r_deg, centre_world_mm));
+  }
+  // A far start is off in translation too: each rotation is judged where a rough 2D alignment puts it. The alignments
+  // run side by side; the first runs alone so that the level's renderers exist before the others look them up (every
+  // grid pose keeps the start's bone centre, so they all use the same coarsened CT).
+  const int halvings = roughAlignmentHalvings(registrationCase, level);
+  std::vector<std::optional<Result<ShiftAlignment>>> rough(rotated.size());
+  const auto alignRoughly = [&](std::size_t i) {
+    rough[i] = ProjectionShiftAligner::align(registrationCase, rotated[i], level, 0.5, 0.2, halvings);
+  };
+  if (rotated.empty()) return std::vector<RotationSweepCandidate>{};
+  alignRoughly(0);
+  if (!*rough[0]) return fail(rough[0]->error());
+  tbb::parallel_for(std::size_t{1}, rotated.size(), alignRoughly);
+  std::vector<GridPose> grid;
+  for (std::size_t i = 0; i < rotated.size(); ++i) {
+    if (!*rough[i]) return fail(rough[i]->error());
+    const Eigen::Isometry3d& T = rough[i]->value().T_world_from_ct;
     auto similarity = gridObjective.similarity(T);
     if (!similarity) return fail(similarity.error());
     grid.push_back({T, similarity.value()});

@@ -1,5 +1,6 @@
 // ProjectionShiftAligner: a start translated far from the truth is brought back near it by the 2D shifts of its DRRs,
-// in three views and (within the plane it sees) in one; a start at the truth stays; bad arguments fail.
+// in three views and (within the plane it sees) in one, also when matched on halved images; a start at the truth
+// stays; bad arguments fail.
 #include <gtest/gtest.h>
 
 #include "Registration/ProjectionShiftAligner.h"
@@ -54,6 +55,17 @@ TEST(ProjectionShiftAligner, AStartAtTheTruthStaysWithinAFractionOfAPixel) {
   EXPECT_LT(aligned.value().translation_world_mm.norm(), 2.0);
 }
 
+TEST(ProjectionShiftAligner, AMatchOnAHalvedImageBringsTheStartWithinAFewMm) {
+  Prepared p = prepare(3);
+  const Eigen::Isometry3d start = Eigen::Translation3d(35.0, -30.0, 38.0) * p.simulated.T_truth;
+  auto aligned = fct::ProjectionShiftAligner::align(p.registrationCase, start, 1, 0.5, 0.2, 1);
+  ASSERT_TRUE(aligned.ok()) << aligned.error();
+  for (double peak : aligned.value().peakCorrelation) EXPECT_GT(peak, 0.8);
+  // Matched at 32x32 (the level-1 image halved): a pixel is 9.6 mm on the detector, about 6.7 mm at the bone.
+  EXPECT_LT(centreDistance_mm(p, aligned.value().T_world_from_ct, p.simulated.T_truth), 4.0)
+      << "moved by " << aligned.value().translation_world_mm.transpose();
+}
+
 TEST(ProjectionShiftAligner, RejectsABadLevelOrRange) {
   Prepared p = prepare(1);
   auto level = fct::ProjectionShiftAligner::align(p.registrationCase, p.simulated.T_truth, 9);
@@ -63,5 +75,10 @@ TEST(ProjectionShiftAligner, RejectsABadLevelOrRange) {
     auto range = fct::ProjectionShiftAligner::align(p.registrationCase, p.simulated.T_truth, 2, fraction);
     ASSERT_FALSE(range.ok()) << fraction;
     EXPECT_NE(range.error().find("fraction of the image"), std::string::npos) << range.error();
+  }
+  for (int halvings : {-1, 4}) {
+    auto coarse = fct::ProjectionShiftAligner::align(p.registrationCase, p.simulated.T_truth, 1, 0.5, 0.2, halvings);
+    ASSERT_FALSE(coarse.ok()) << halvings;
+    EXPECT_NE(coarse.error().find("0 to 3 halvings"), std::string::npos) << coarse.error();
   }
 }

@@ -1,5 +1,6 @@
 // RotationSweep: the grid of rotation offsets, a start turned 40 deg about the bone centre brought back within a grid
-// step by the sweep (and registered with the default preset), and a start at the truth left alone.
+// step by the sweep (also when it is 40 mm off in translation as well), registered with the default preset, and a
+// start at the truth left alone.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -85,6 +86,39 @@ TEST(RotationSweep, BringsAStartTurned40DegreesWithinAGridStepAndLeavesTheTruthA
                                          stage.rotationSweep, stage.level, truth, truthSimilarity);
   ASSERT_TRUE(atTruth.ok()) << atTruth.error();
   EXPECT_TRUE(atTruth.value().empty()) << "no grid pose beats the truth";
+}
+
+TEST(RotationSweep, JudgesEachRotationWhereARoughAlignmentPutsItSoAStartAlsoFarOffInTranslationIsFound) {
+  Prepared p = prepare();
+  const fct::RegistrationStage stage = globalStage();
+  auto objective = fct::RegistrationObjective::create(p.registrationCase, stage);
+  ASSERT_TRUE(objective.ok()) << objective.error();
+  fct::RegistrationStage gridStage = stage;
+  gridStage.pixels.maxPixels = stage.rotationSweep.maxPixels;
+  auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage);
+  ASSERT_TRUE(gridObjective.ok()) << gridObjective.error();
+  const Eigen::Vector3d centre_ct_mm = p.registrationCase.rotationCentre_ct_mm();
+  const Eigen::Isometry3d T_start = Eigen::Translation3d(25.0, -20.0, 25.0) * turned(p, 40.0, Eigen::Vector3d(1, -2, 1));
+  const auto start = fct::RigidPose::fromTransform(T_start, centre_ct_mm).value().asVector();
+  const double startSimilarity = objective.value().similarity(T_start).value();
+  auto found = fct::RotationSweep::run(p.registrationCase, gridObjective.value(), objective.value(), stage.rotationSweep,
+                                       stage.level, start, startSimilarity);
+  ASSERT_TRUE(found.ok()) << found.error();
+  ASSERT_FALSE(found.value().empty());
+  const Eigen::Isometry3d T_best = p.registrationCase.poseTransform(found.value().front().params);
+  const double centreOff_mm = (T_best * centre_ct_mm - p.simulated.T_truth * centre_ct_mm).norm();
+  std::printf("from 40 deg and %.1f mm: %.1f deg and %.1f mm from the truth\n",
+              (T_start * centre_ct_mm - p.simulated.T_truth * centre_ct_mm).norm(),
+              angleBetween_deg(T_best, p.simulated.T_truth), centreOff_mm);
+  EXPECT_LT(angleBetween_deg(T_best, p.simulated.T_truth), 15.0);
+  EXPECT_LT(centreOff_mm, 10.0);
+}
+
+TEST(RotationSweep, HalvesTheLevelForItsRoughAlignmentDownToImagesOf32Pixels) {
+  Prepared p = prepare();  // 128x128 detector: levels of 128, 64 and 32 pixels
+  EXPECT_EQ(fct::RotationSweep::roughAlignmentHalvings(p.registrationCase, 0), 2);
+  EXPECT_EQ(fct::RotationSweep::roughAlignmentHalvings(p.registrationCase, 1), 1);
+  EXPECT_EQ(fct::RotationSweep::roughAlignmentHalvings(p.registrationCase, 2), 0);
 }
 
 TEST(RotationSweep, TheDefaultPresetRegistersAStartTurned45Degrees) {
