@@ -33,6 +33,13 @@ fct::RegistrationStage globalStage() {
   return fct::RegistrationSchedule::builtin(fct::RegistrationSchedule::kDefaultPreset).value().stages.front();
 }
 
+/// The stage with the sweep's sparser pixel set, which ranks the grid.
+fct::RegistrationStage gridStage(const fct::RegistrationStage& stage) {
+  fct::RegistrationStage grid = stage;
+  grid.pixels.maxPixels = stage.rotationSweep.maxPixels;
+  return grid;
+}
+
 }  // namespace
 
 TEST(RotationSweep, GridHoldsEveryMultipleOfTheStepWithinTheRadiusButZero) {
@@ -53,9 +60,7 @@ TEST(RotationSweep, BringsAStartTurned40DegreesWithinAGridStepAndLeavesTheTruthA
   ASSERT_GT(stage.rotationSweep.maxRotation_deg, 0.0);
   auto objective = fct::RegistrationObjective::create(p.registrationCase, stage);
   ASSERT_TRUE(objective.ok()) << objective.error();
-  fct::RegistrationStage gridStage = stage;
-  gridStage.pixels.maxPixels = stage.rotationSweep.maxPixels;
-  auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage);
+  auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage(stage));
   ASSERT_TRUE(gridObjective.ok()) << gridObjective.error();
 
   const Eigen::Vector3d centre_ct_mm = p.registrationCase.rotationCentre_ct_mm();
@@ -92,17 +97,13 @@ TEST(RotationSweep, JudgesEachRotationWhereARoughAlignmentPutsItSoAStartAlsoFarO
   Prepared p = prepare();
   const fct::RegistrationStage stage = globalStage();
   auto objective = fct::RegistrationObjective::create(p.registrationCase, stage);
-  ASSERT_TRUE(objective.ok()) << objective.error();
-  fct::RegistrationStage gridStage = stage;
-  gridStage.pixels.maxPixels = stage.rotationSweep.maxPixels;
-  auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage);
-  ASSERT_TRUE(gridObjective.ok()) << gridObjective.error();
+  auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage(stage));
+  ASSERT_TRUE(objective.ok() && gridObjective.ok());
   const Eigen::Vector3d centre_ct_mm = p.registrationCase.rotationCentre_ct_mm();
   const Eigen::Isometry3d T_start = Eigen::Translation3d(25.0, -20.0, 25.0) * turned(p, 40.0, Eigen::Vector3d(1, -2, 1));
-  const auto start = fct::RigidPose::fromTransform(T_start, centre_ct_mm).value().asVector();
-  const double startSimilarity = objective.value().similarity(T_start).value();
   auto found = fct::RotationSweep::run(p.registrationCase, gridObjective.value(), objective.value(), stage.rotationSweep,
-                                       stage.level, start, startSimilarity);
+                                       stage.level, fct::RigidPose::fromTransform(T_start, centre_ct_mm).value().asVector(),
+                                       objective.value().similarity(T_start).value());
   ASSERT_TRUE(found.ok()) << found.error();
   ASSERT_FALSE(found.value().empty());
   const Eigen::Isometry3d T_best = p.registrationCase.poseTransform(found.value().front().params);
