@@ -3,10 +3,10 @@
 // (a rough manual placement, the clinical setup alone) lies outside the basin the stage's search can reach: the genetic
 // search spreads its guesses a few degrees, and the shift pre-alignment corrects translation only. The sweep rotates
 // the start about the bone centre by every offset of a cubic grid of rotation vectors (spacing `step_deg`, within
-// `max_deg`), lines each up roughly in 2D with the ProjectionShiftAligner at a fraction of the level's resolution (a far start
-// is off in translation too, and a rotation judged where the start puts it is judged on a misplaced outline), ranks
-// them by the stage's similarity, lines the best few up again at the level itself, and returns those that then beat
-// the start: the stage's search refines them beside its start.
+// `max_deg`), lines each up roughly in 2D with the ProjectionShiftAligner at a fraction of the level's resolution
+// (a far start is off in translation too, and a rotation judged where the start puts it is judged on a misplaced
+// outline), ranks them by the stage's similarity, lines the best few up again at the level itself, and returns those
+// that then beat the start: the stage's search refines them beside its start.
 
 #include <Eigen/Geometry>
 

@@ -100,9 +100,11 @@ TEST(RotationSweep, JudgesEachRotationWhereARoughAlignmentPutsItSoAStartAlsoFarO
   auto gridObjective = fct::RegistrationObjective::create(p.registrationCase, gridStage(stage));
   ASSERT_TRUE(objective.ok() && gridObjective.ok());
   const Eigen::Vector3d centre_ct_mm = p.registrationCase.rotationCentre_ct_mm();
-  const Eigen::Isometry3d T_start = Eigen::Translation3d(25.0, -20.0, 25.0) * turned(p, 40.0, Eigen::Vector3d(1, -2, 1));
-  auto found = fct::RotationSweep::run(p.registrationCase, gridObjective.value(), objective.value(), stage.rotationSweep,
-                                       stage.level, fct::RigidPose::fromTransform(T_start, centre_ct_mm).value().asVector(),
+  const Eigen::Isometry3d T_start =
+      Eigen::Translation3d(25.0, -20.0, 25.0) * turned(p, 40.0, Eigen::Vector3d(1, -2, 1));
+  const auto start = fct::RigidPose::fromTransform(T_start, centre_ct_mm).value().asVector();
+  auto found = fct::RotationSweep::run(p.registrationCase, gridObjective.value(), objective.value(),
+                                       stage.rotationSweep, stage.level, start,
                                        objective.value().similarity(T_start).value());
   ASSERT_TRUE(found.ok()) << found.error();
   ASSERT_FALSE(found.value().empty());
