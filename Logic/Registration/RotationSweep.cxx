@@ -65,24 +65,23 @@ Result<std::vector<RotationSweepCandidate>> RotationSweep::run(RegistrationCase&
                                                                const PoseVector& start, double startSimilarity) {
   const Eigen::Isometry3d T_start = registrationCase.poseTransform(start);
   const Eigen::Vector3d centre_world_mm = T_start * registrationCase.rotationCentre_ct_mm();
-  std::vector<Eigen::Isometry3d> rotated;
+  std::vector<Eigen::Isometry3d> poses{T_start};  // the start's own rotation too: a far start may be off only in place
   for (const Eigen::Vector3d& r_deg : offsets_deg(spec.maxRotation_deg, spec.step_deg)) {
-    rotated.push_back(rotatedAbout(T_start, r_deg, centre_world_mm));
+    poses.push_back(rotatedAbout(T_start, r_deg, centre_world_mm));
   }
   // A far start is off in translation too: each rotation is judged where a rough 2D alignment puts it. The alignments
   // run side by side; the first runs alone so that the level's renderers exist before the others look them up (every
   // grid pose keeps the start's bone centre, so they all use the same coarsened CT).
   const int halvings = roughAlignmentHalvings(registrationCase, level);
-  std::vector<std::optional<Result<ShiftAlignment>>> rough(rotated.size());
+  std::vector<std::optional<Result<ShiftAlignment>>> rough(poses.size());
   const auto alignRoughly = [&](std::size_t i) {
-    rough[i] = ProjectionShiftAligner::align(registrationCase, rotated[i], level, 0.5, 0.2, halvings);
+    rough[i] = ProjectionShiftAligner::align(registrationCase, poses[i], level, 0.5, 0.2, halvings);
   };
-  if (rotated.empty()) return std::vector<RotationSweepCandidate>{};
   alignRoughly(0);
   if (!*rough[0]) return fail(rough[0]->error());
-  tbb::parallel_for(std::size_t{1}, rotated.size(), alignRoughly);
+  tbb::parallel_for(std::size_t{1}, poses.size(), alignRoughly);
   std::vector<GridPose> grid;
-  for (std::size_t i = 0; i < rotated.size(); ++i) {
+  for (std::size_t i = 0; i < poses.size(); ++i) {
     if (!*rough[i]) return fail(rough[i]->error());
     const Eigen::Isometry3d& T = rough[i]->value().T_world_from_ct;
     auto similarity = gridObjective.similarity(T);

@@ -38,8 +38,8 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
   EXPECT_EQ(s[0].metric, fct::SimilarityMetric::Ncc);
   EXPECT_EQ(s[0].search, fct::SearchStrategy::Genetic);
   EXPECT_GT(s[0].pixels.maxPixels, 0) << "the global stage samples its level sparsely";
-  EXPECT_TRUE(s[0].shiftPrealign) << "a far start is first lined up in 2D";
-  EXPECT_GE(s[0].rotationSweep.maxRotation_deg, 45.0) << "and looked around on a grid of rotations";
+  EXPECT_GE(s[0].rotationSweep.maxRotation_deg, 45.0) << "a far start is looked around on a grid of rotations";
+  EXPECT_FALSE(s[0].shiftPrealign) << "the sweep lines up every pose it ranks in 2D, the start's own too";
   EXPECT_FALSE(s[0].metalReview);
   EXPECT_TRUE(s[1].metalReview) << "the first stage after the global search reviews the metal masks";
   EXPECT_FALSE(s[2].metalReview);
