@@ -253,10 +253,12 @@ Result<double> startSimilarityAt(RegistrationCase& registrationCase, const Regis
 
 /// The stage's rotation sweep from `current`: fills start.sweepSeeds for a genetic search, or moves `current` to the
 /// sweep's best pose for the others. The grid is ranked on the stage's whole images at the sweep's pixel budget (made
-/// like the stage's objective, at `current`). Fails, naming the stage, on a rendering error.
+/// like the stage's objective, at `current`). When the best pose lies far from `T_objective` (where `objective` was
+/// made), the objective is made again there (its cut-face masks and coarse CT belong to the pose the search refines)
+/// and T_objective moved. Fails, naming the stage, on a rendering error.
 Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStage& stage,
                       const RegistrationAblation& ablation, bool useViewRenderers, RegistrationObjective& objective,
-                      StageStart& start, PoseVector& current) {
+                      Eigen::Isometry3d& T_objective, StageStart& start, PoseVector& current) {
   auto startSimilarity = startSimilarityAt(registrationCase, stage, objective, current, start.similarity);
   if (!startSimilarity) return fail(startSimilarity.error());
   start.similarity = startSimilarity.value();
@@ -275,6 +277,14 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
     current = found.value().front().params;
     start.similarity = found.value().front().similarity;
     start.sweepSeeds.resize(1);
+  }
+  const Eigen::Isometry3d T_best = registrationCase.poseTransform(found.value().front().params);
+  if (boneMotionBound_mm(registrationCase, T_objective, T_best) > kObjectiveRebuildDistance_mm) {
+    auto rebuilt = objectiveAt(registrationCase, stage, ablation, useViewRenderers, T_best);
+    if (!rebuilt) return fail(fmt::format("stage '{}': {}", stage.name, rebuilt.error()));
+    objective = std::move(rebuilt).value();
+    T_objective = T_best;
+    start.similarity = std::numeric_limits<double>::quiet_NaN();
   }
   return Ok{};
 }
@@ -370,6 +380,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
 
   auto objectives = createObjectives(registrationCase, schedule, options.ablation, useViewRenderers, T_initial);
   if (!objectives) return fail(objectives.error());
+  std::vector<Eigen::Isometry3d> T_objectives(schedule.stages.size(), T_initial);  // where each objective was made
   result.drrMethod = std::string(objectives.value().front().drrMethodName());
 
   const StageContext context{registrationCase, monitor, onProgress, static_cast<int>(schedule.stages.size())};
@@ -394,6 +405,7 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
               objectiveAt(registrationCase, schedule.stages[j], options.ablation, useViewRenderers, T_review);
           if (!rebuilt) return fail(rebuilt.error());
           objectives.value()[j] = std::move(rebuilt).value();
+          T_objectives[j] = T_review;
         }
       }
     }
@@ -403,19 +415,20 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       stageStart.prealignShift_world_mm = outcome.value().shift_world_mm;
       stageStart.similarity = outcome.value().similarity;
     }
-    // A stage whose start lies far from the run's initial pose (after a far start's first stage, or its shift
+    // A stage whose start lies far from where its objective was made (after a far start's first stage, or its shift
     // pre-alignment) makes its pixel sets (cut-face masks) and coarse CT again at its own start pose; a similarity
     // made with the old ones no longer holds.
     const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
-    if (boneMotionBound_mm(registrationCase, T_initial, T_stageStart) > kObjectiveRebuildDistance_mm) {
+    if (boneMotionBound_mm(registrationCase, T_objectives[i], T_stageStart) > kObjectiveRebuildDistance_mm) {
       auto rebuilt = objectiveAt(registrationCase, stage, options.ablation, useViewRenderers, T_stageStart);
       if (!rebuilt) return fail(rebuilt.error());
       objectives.value()[i] = std::move(rebuilt).value();
+      T_objectives[i] = T_stageStart;
       stageStart.similarity = std::numeric_limits<double>::quiet_NaN();
     }
     if (stage.rotationSweep.maxRotation_deg > 0.0) {
       const Status swept = sweepRotations(registrationCase, stage, options.ablation, useViewRenderers,
-                                          objectives.value()[i], stageStart, current);
+                                          objectives.value()[i], T_objectives[i], stageStart, current);
       if (!swept) return fail(swept.error());
     }
     auto report = runStage(context, s, stage, objectives.value()[i], result.totalDrrs, stageStart, current);
