@@ -153,7 +153,7 @@ Result<ShiftAlignment> ProjectionShiftAligner::align(RegistrationCase& registrat
     }
     const FloatImage& xrayImage = coarsening > 0 ? coarseImage : xray.image;
     const ValidMask& xrayMask = coarsening > 0 ? coarseMask : xray.mask;
-    auto renderer = registrationCase.levelRenderer(v, level, T_world_from_ct);
+    auto renderer = registrationCase.levelRenderer(v, level, T_world_from_ct, 1 << coarsening);
     if (!renderer) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), renderer.error()));
     auto drr = renderer.value()->render(registrationCase.camera(v), T_world_from_ct, matchLevel);
     if (!drr) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), drr.error()));
