@@ -251,6 +251,21 @@ Result<double> startSimilarityAt(RegistrationCase& registrationCase, const Regis
   return value.value();
 }
 
+/// Makes `objective` again at T_at when T_at lies more than kObjectiveRebuildDistance_mm of bone motion from
+/// T_objective (where it was made): its cut-face masks and coarse CT then belong to T_at. Moves T_objective there and
+/// returns true when it did. Fails, naming the stage, when the objective cannot be made.
+Result<bool> remakeObjectiveIfFar(RegistrationCase& registrationCase, const RegistrationStage& stage,
+                                  const RegistrationAblation& ablation, bool useViewRenderers,
+                                  const Eigen::Isometry3d& T_at, RegistrationObjective& objective,
+                                  Eigen::Isometry3d& T_objective) {
+  if (!(boneMotionBound_mm(registrationCase, T_objective, T_at) > kObjectiveRebuildDistance_mm)) return false;
+  auto remade = objectiveAt(registrationCase, stage, ablation, useViewRenderers, T_at);
+  if (!remade) return fail(fmt::format("stage '{}': {}", stage.name, remade.error()));
+  objective = std::move(remade).value();
+  T_objective = T_at;
+  return true;
+}
+
 /// The stage's rotation sweep from `current`: fills start.sweepSeeds for a genetic search, or moves `current` to the
 /// sweep's best pose for the others. The grid is ranked on the stage's whole images at the sweep's pixel budget (made
 /// like the stage's objective, at `current`). When the best pose lies far from `T_objective` (where `objective` was
@@ -278,14 +293,11 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
     start.similarity = found.value().front().similarity;
     start.sweepSeeds.resize(1);
   }
-  const Eigen::Isometry3d T_best = registrationCase.poseTransform(found.value().front().params);
-  if (boneMotionBound_mm(registrationCase, T_objective, T_best) > kObjectiveRebuildDistance_mm) {
-    auto rebuilt = objectiveAt(registrationCase, stage, ablation, useViewRenderers, T_best);
-    if (!rebuilt) return fail(fmt::format("stage '{}': {}", stage.name, rebuilt.error()));
-    objective = std::move(rebuilt).value();
-    T_objective = T_best;
-    start.similarity = std::numeric_limits<double>::quiet_NaN();
-  }
+  auto remade = remakeObjectiveIfFar(registrationCase, stage, ablation, useViewRenderers,
+                                     registrationCase.poseTransform(found.value().front().params), objective,
+                                     T_objective);
+  if (!remade) return fail(remade.error());
+  if (remade.value()) start.similarity = std::numeric_limits<double>::quiet_NaN();
   return Ok{};
 }
 
@@ -418,14 +430,10 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
     // A stage whose start lies far from where its objective was made (after a far start's first stage, or its shift
     // pre-alignment) makes its pixel sets (cut-face masks) and coarse CT again at its own start pose; a similarity
     // made with the old ones no longer holds.
-    const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
-    if (boneMotionBound_mm(registrationCase, T_objectives[i], T_stageStart) > kObjectiveRebuildDistance_mm) {
-      auto rebuilt = objectiveAt(registrationCase, stage, options.ablation, useViewRenderers, T_stageStart);
-      if (!rebuilt) return fail(rebuilt.error());
-      objectives.value()[i] = std::move(rebuilt).value();
-      T_objectives[i] = T_stageStart;
-      stageStart.similarity = std::numeric_limits<double>::quiet_NaN();
-    }
+    auto remade = remakeObjectiveIfFar(registrationCase, stage, options.ablation, useViewRenderers,
+                                       registrationCase.poseTransform(current), objectives.value()[i], T_objectives[i]);
+    if (!remade) return fail(remade.error());
+    if (remade.value()) stageStart.similarity = std::numeric_limits<double>::quiet_NaN();
     if (stage.rotationSweep.maxRotation_deg > 0.0) {
       const Status swept = sweepRotations(registrationCase, stage, options.ablation, useViewRenderers,
                                           objectives.value()[i], T_objectives[i], stageStart, current);
