@@ -26,11 +26,12 @@ double parabolaPeak(double a, double b, double c) {
   return std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
 }
 
-/// The shift of `drr` (its footprint: the bounding box of the pixels above 5 % of its largest value) that correlates
-/// best with `xray` over its valid pixels, searched up to maxShiftFraction of the image per axis; nullopt when the DRR
-/// or the X-ray's valid pixels are empty or constant.
-std::optional<LevelShift> bestShift(const FloatImage& drr, const FloatImage& xray, const ValidMask& mask,
-                                    double maxShiftFraction) {
+/// The shift of the DRR that correlates best with `xray`: `grownDrr` is the DRR on the level's detector grown by
+/// pad.x() columns and pad.y() rows on every side, so that it shows what every shift within the pad brings into the
+/// field. The X-ray (its invalid pixels set to its valid mean) is the template, slid over the grown DRR; nullopt when
+/// the X-ray has no valid pixel, the DRR is empty, or the best match lies on the border of the shift range.
+std::optional<LevelShift> bestShift(const FloatImage& grownDrr, const Eigen::Vector2i& pad, const FloatImage& xray,
+                                    const ValidMask& mask) {
   double sum = 0.0;
   std::size_t count = 0;
   for (std::size_t i = 0; i < xray.pixels.size(); ++i) {
@@ -40,57 +41,41 @@ std::optional<LevelShift> bestShift(const FloatImage& drr, const FloatImage& xra
     }
   }
   if (count == 0) return std::nullopt;
+  if (!(*std::max_element(grownDrr.pixels.begin(), grownDrr.pixels.end()) > 0.0f)) return std::nullopt;
   const auto mean = static_cast<float>(sum / static_cast<double>(count));
-  cv::Mat image(xray.rows, xray.cols, CV_32F);
+  cv::Mat templ(xray.rows, xray.cols, CV_32F);
   for (int r = 0; r < xray.rows; ++r) {
-    for (int c = 0; c < xray.cols; ++c) image.at<float>(r, c) = mask.isValid(c, r) ? xray.at(c, r) : mean;
+    for (int c = 0; c < xray.cols; ++c) templ.at<float>(r, c) = mask.isValid(c, r) ? xray.at(c, r) : mean;
   }
-  const float largest = *std::max_element(drr.pixels.begin(), drr.pixels.end());
-  if (!(largest > 0.0f)) return std::nullopt;
-  int c0 = drr.cols, c1 = -1, r0 = drr.rows, r1 = -1;
-  for (int r = 0; r < drr.rows; ++r) {
-    for (int c = 0; c < drr.cols; ++c) {
-      if (drr.at(c, r) > 0.05f * largest) {
-        c0 = std::min(c0, c);
-        c1 = std::max(c1, c);
-        r0 = std::min(r0, r);
-        r1 = std::max(r1, r);
-      }
-    }
-  }
-  if (c1 - c0 < 2 || r1 - r0 < 2) return std::nullopt;
-  const cv::Rect box(c0, r0, c1 - c0 + 1, r1 - r0 + 1);
-  const cv::Mat drrMat(drr.rows, drr.cols, CV_32F, const_cast<float*>(drr.pixels.data()));
-  const cv::Mat templ = drrMat(box).clone();
-  const int padCols = static_cast<int>(std::ceil(maxShiftFraction * xray.cols));
-  const int padRows = static_cast<int>(std::ceil(maxShiftFraction * xray.rows));
-  cv::Mat padded;
-  cv::copyMakeBorder(image, padded, padRows, padRows, padCols, padCols, cv::BORDER_CONSTANT, cv::Scalar(mean));
+  const cv::Mat drr(grownDrr.rows, grownDrr.cols, CV_32F, const_cast<float*>(grownDrr.pixels.data()));
   cv::Mat correlation;
-  cv::matchTemplate(padded, templ, correlation, cv::TM_CCOEFF_NORMED);
-  // Template position (top-left in `padded`) of zero shift, and the positions within the shift range.
-  const int zeroCol = box.x + padCols, zeroRow = box.y + padRows;
-  const cv::Rect range = cv::Rect(zeroCol - padCols, zeroRow - padRows, 2 * padCols + 1, 2 * padRows + 1) &
-                         cv::Rect(0, 0, correlation.cols, correlation.rows);
-  if (range.empty()) return std::nullopt;
+  cv::matchTemplate(drr, templ, correlation, cv::TM_CCOEFF_NORMED);
+  if (correlation.cols != 2 * pad.x() + 1 || correlation.rows != 2 * pad.y() + 1) return std::nullopt;
   double peak = 0.0;
   cv::Point at;
-  cv::minMaxLoc(correlation(range), nullptr, &peak, nullptr, &at);
+  cv::minMaxLoc(correlation, nullptr, &peak, nullptr, &at);
   if (!std::isfinite(peak)) return std::nullopt;
   // A peak on the border of the range is a cut-off slope, not a match.
-  if (at.x == 0 || at.y == 0 || at.x == range.width - 1 || at.y == range.height - 1) return std::nullopt;
-  at += range.tl();
+  if (at.x == 0 || at.y == 0 || at.x == correlation.cols - 1 || at.y == correlation.rows - 1) return std::nullopt;
+  const auto value = [&](int r, int c) { return static_cast<double>(correlation.at<float>(r, c)); };
+  // The X-ray matches the DRR's content `offset` pixels away; the DRR moves by minus that offset.
+  const Eigen::Vector2d offset(at.x - pad.x() + parabolaPeak(value(at.y, at.x - 1), peak, value(at.y, at.x + 1)),
+                               at.y - pad.y() + parabolaPeak(value(at.y - 1, at.x), peak, value(at.y + 1, at.x)));
   LevelShift shift;
   shift.correlation = peak;
-  shift.shift_px = Eigen::Vector2d(at.x - zeroCol, at.y - zeroRow);
-  const auto value = [&](int r, int c) { return static_cast<double>(correlation.at<float>(r, c)); };
-  if (at.x > 0 && at.x + 1 < correlation.cols) {
-    shift.shift_px.x() += parabolaPeak(value(at.y, at.x - 1), peak, value(at.y, at.x + 1));
-  }
-  if (at.y > 0 && at.y + 1 < correlation.rows) {
-    shift.shift_px.y() += parabolaPeak(value(at.y - 1, at.x), peak, value(at.y + 1, at.x));
-  }
+  shift.shift_px = -offset;
   return shift;
+}
+
+/// `camera` with its detector grown by pad_px pixels of pyramid `level` on every side: its level-`level` image is the
+/// original level's image with that border around it (the same rays through the original pixels).
+Result<Camera> grownDetector(const Camera& camera, const Eigen::Vector2i& pad_px, int level) {
+  CameraIntrinsics grown = camera.intrinsics();
+  const int scale = 1 << level;
+  grown.cols += 2 * pad_px.x() * scale;
+  grown.rows += 2 * pad_px.y() * scale;
+  grown.principalPoint_px += Eigen::Vector2d(pad_px.x() * scale, pad_px.y() * scale);
+  return Camera::create(grown, camera.T_world_from_camera());
 }
 
 /// The translation t (world mm) for which each camera projects centre + t nearest its target (full-resolution px):
@@ -155,14 +140,18 @@ Result<ShiftAlignment> ProjectionShiftAligner::align(RegistrationCase& registrat
     const ValidMask& xrayMask = coarsening > 0 ? coarseMask : xray.mask;
     auto renderer = registrationCase.levelRenderer(v, level, T_world_from_ct, 1 << coarsening);
     if (!renderer) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), renderer.error()));
-    auto drr = renderer.value()->render(registrationCase.camera(v), T_world_from_ct, matchLevel);
+    const Eigen::Vector2i pad(static_cast<int>(std::ceil(maxShiftFraction * xrayImage.cols)),
+                              static_cast<int>(std::ceil(maxShiftFraction * xrayImage.rows)));
+    auto camera = grownDetector(registrationCase.camera(v), pad, matchLevel);
+    if (!camera) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), camera.error()));
+    auto drr = renderer.value()->render(camera.value(), T_world_from_ct, matchLevel);
     if (!drr) return fail(fmt::format("view '{}': {}", registrationCase.viewName(v), drr.error()));
-    if (drr.value().cols != xrayImage.cols || drr.value().rows != xrayImage.rows) {
-      return fail(fmt::format("view '{}': the {}x{} DRR of the coarsened level does not match its {}x{} X-ray",
+    if (drr.value().cols != xrayImage.cols + 2 * pad.x() || drr.value().rows != xrayImage.rows + 2 * pad.y()) {
+      return fail(fmt::format("view '{}': the {}x{} DRR of the grown detector does not frame its {}x{} X-ray",
                               registrationCase.viewName(v), drr.value().cols, drr.value().rows, xrayImage.cols,
                               xrayImage.rows));
     }
-    const std::optional<LevelShift> shift = bestShift(drr.value(), xrayImage, xrayMask, maxShiftFraction);
+    const std::optional<LevelShift> shift = bestShift(drr.value(), pad, xrayImage, xrayMask);
     out.shift_px.push_back(shift ? Eigen::Vector2d(levelScale * shift->shift_px) : Eigen::Vector2d::Zero());
     out.peakCorrelation.push_back(shift ? shift->correlation : 0.0);
     if (!shift || shift->correlation < minPeakCorrelation) continue;

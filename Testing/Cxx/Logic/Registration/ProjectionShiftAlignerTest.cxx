@@ -1,7 +1,9 @@
 // ProjectionShiftAligner: a start translated far from the truth is brought back near it by the 2D shifts of its DRRs,
-// in three views and (within the plane it sees) in one, also when matched on halved images; a start at the truth
-// stays; bad arguments fail.
+// in three views and (within the plane it sees) in one, also when matched on halved images and when the CT is longer
+// than the field; a start at the truth stays; bad arguments fail.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 #include "Registration/ProjectionShiftAligner.h"
 #include "CoarsePhantomCase.h"
@@ -62,6 +64,32 @@ TEST(ProjectionShiftAligner, AMatchOnAHalvedImageBringsTheStartWithinAFewMm) {
   ASSERT_TRUE(aligned.ok()) << aligned.error();
   for (double peak : aligned.value().peakCorrelation) EXPECT_GT(peak, 0.8);
   // Matched at 32x32 (the level-1 image halved): a pixel is 9.6 mm on the detector, about 6.7 mm at the bone.
+  EXPECT_LT(centreDistance_mm(p, aligned.value().T_world_from_ct, p.simulated.T_truth), 4.0)
+      << "moved by " << aligned.value().translation_world_mm.transpose();
+}
+
+TEST(ProjectionShiftAligner, FindsAShiftAlongACtLongerThanTheField) {
+  // A 115 mm detector (about 80 mm at the bone) inside the phantom's 160 x 160 x 120 mm body: every view's DRR fills
+  // its whole image at every shift, so only the content that a shift brings into the field can tell where it lines up.
+  fct::test::KnownTruthOptions options;
+  options.cols = options.rows = 96;
+  options.pixelSpacing_mm = 1.2;
+  auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), options);
+  ASSERT_TRUE(simulated.ok()) << simulated.error();
+  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {});
+  ASSERT_TRUE(registrationCase.ok()) << registrationCase.error();
+  Prepared p{std::move(simulated).value(), std::move(registrationCase).value()};
+  for (std::size_t v = 0; v < p.registrationCase.viewCount(); ++v) {
+    auto drr = p.registrationCase.levelRenderer(v, 1, p.simulated.T_truth, 1)
+                   .value()
+                   ->render(p.registrationCase.camera(v), p.simulated.T_truth, 1);
+    ASSERT_TRUE(drr.ok()) << drr.error();
+    EXPECT_GT(*std::min_element(drr.value().pixels.begin(), drr.value().pixels.end()), 0.0f) << "view " << v;
+  }
+  const Eigen::Vector3d alongTheBody_mm(0.0, 0.0, 30.0);
+  const Eigen::Isometry3d start = Eigen::Translation3d(alongTheBody_mm) * p.simulated.T_truth;
+  auto aligned = fct::ProjectionShiftAligner::align(p.registrationCase, start, 1);
+  ASSERT_TRUE(aligned.ok()) << aligned.error();
   EXPECT_LT(centreDistance_mm(p, aligned.value().T_world_from_ct, p.simulated.T_truth), 4.0)
       << "moved by " << aligned.value().translation_world_mm.transpose();
 }
