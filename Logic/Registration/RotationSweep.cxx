@@ -96,7 +96,8 @@ Result<std::vector<RotationSweepCandidate>> RotationSweep::run(RegistrationCase&
     auto unshifted = objective.similarity(pose.T_world_from_ct);
     if (!unshifted) return fail(unshifted.error());
     pose.similarity = unshifted.value();
-    auto shifted = ProjectionShiftAligner::align(registrationCase, pose.T_world_from_ct, level);
+    auto shifted =
+        ProjectionShiftAligner::align(registrationCase, pose.T_world_from_ct, level, kFineAlignmentShiftFraction);
     if (!shifted) return fail(shifted.error());
     auto similarity = objective.similarity(shifted.value().T_world_from_ct);
     if (!similarity) return fail(similarity.error());

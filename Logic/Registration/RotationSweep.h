@@ -34,6 +34,10 @@ class RotationSweep {
   /// level 2: 32^2).
   static constexpr int kRoughAlignmentMaxHalvings = 2;
   static constexpr int kRoughAlignmentMinSide_px = 32;
+  /// The best `aligned` poses are lined up again at the level over shifts up to this fraction of the image per axis:
+  /// the rough alignment has put them within a pixel or two of its coarser image (1/16 of the level's for two halvings
+  /// at 0.5), and every fraction of the range costs rays on both sides of the detector.
+  static constexpr double kFineAlignmentShiftFraction = 0.125;
   /// The halvings of `level` for the rough alignment of registrationCase's views (0 when the level is already small).
   static int roughAlignmentHalvings(const RegistrationCase& registrationCase, int level);
   /// The grid's rotation vectors (deg, world axes), zero excluded: every multiple of `step_deg` per axis whose length
