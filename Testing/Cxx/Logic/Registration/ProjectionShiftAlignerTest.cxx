@@ -74,11 +74,7 @@ TEST(ProjectionShiftAligner, FindsAShiftAlongACtLongerThanTheField) {
   fct::test::KnownTruthOptions options;
   options.cols = options.rows = 96;
   options.pixelSpacing_mm = 1.2;
-  auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), options);
-  ASSERT_TRUE(simulated.ok()) << simulated.error();
-  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {});
-  ASSERT_TRUE(registrationCase.ok()) << registrationCase.error();
-  Prepared p{std::move(simulated).value(), std::move(registrationCase).value()};
+  Prepared p = fct::test::preparePhantom(options, 3);
   for (std::size_t v = 0; v < p.registrationCase.viewCount(); ++v) {
     auto drr = p.registrationCase.levelRenderer(v, 1, p.simulated.T_truth, 1)
                    .value()
