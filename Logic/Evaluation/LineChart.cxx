@@ -58,25 +58,35 @@ void verticalText(cv::Mat& image, const std::string& text, int x, int y) {
   rotated.copyTo(image(cv::Rect(left, top, rotated.cols, rotated.rows)));
 }
 
+/// Series colours, RGB: the Okabe-Ito palette (without yellow, too faint on white), then black.
+constexpr std::array<std::array<std::uint8_t, 3>, 7> kSeriesColours{
+    {{0, 114, 178}, {213, 94, 0}, {0, 158, 115}, {204, 121, 167}, {86, 180, 233}, {230, 159, 0}, {0, 0, 0}}};
+
 cv::Scalar bgr(std::size_t n) {
   const auto c = LineChart::seriesColour(n);
   return cv::Scalar(c[2], c[1], c[0]);
+}
+
+/// Draws series n's marker centred at `at` (a filled disc of radius 4, or an outline shape about 10 px across).
+void drawSeriesMarker(cv::Mat& image, const cv::Point& at, std::size_t n) {
+  switch (LineChart::seriesMarker(n)) {
+    case ChartMarker::Disc: cv::circle(image, at, 4, bgr(n), cv::FILLED, cv::LINE_AA); return;
+    case ChartMarker::Square: cv::drawMarker(image, at, bgr(n), cv::MARKER_SQUARE, 10, 2, cv::LINE_AA); return;
+    case ChartMarker::Diamond: cv::drawMarker(image, at, bgr(n), cv::MARKER_DIAMOND, 12, 2, cv::LINE_AA); return;
+    case ChartMarker::Triangle: cv::drawMarker(image, at, bgr(n), cv::MARKER_TRIANGLE_UP, 12, 2, cv::LINE_AA); return;
+  }
 }
 
 Result<RgbImage> drawUnguarded(const ChartSpec& spec);
 
 }  // namespace
 
-std::array<std::uint8_t, 3> LineChart::seriesColour(std::size_t n) {
-  // Okabe-Ito palette (without yellow, too faint on white), then black.
-  static constexpr std::array<std::array<std::uint8_t, 3>, 7> kColours{{{0, 114, 178},
-                                                                      {213, 94, 0},
-                                                                      {0, 158, 115},
-                                                                      {204, 121, 167},
-                                                                      {86, 180, 233},
-                                                                      {230, 159, 0},
-                                                                      {0, 0, 0}}};
-  return kColours[n % kColours.size()];
+std::array<std::uint8_t, 3> LineChart::seriesColour(std::size_t n) { return kSeriesColours[n % kSeriesColours.size()]; }
+
+ChartMarker LineChart::seriesMarker(std::size_t n) {
+  static constexpr std::array<ChartMarker, 4> kMarkers{ChartMarker::Disc, ChartMarker::Square, ChartMarker::Diamond,
+                                                       ChartMarker::Triangle};
+  return kMarkers[(n / kSeriesColours.size()) % kMarkers.size()];
 }
 
 Result<RgbImage> LineChart::draw(const ChartSpec& spec) {
@@ -184,7 +194,7 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
         cv::line(plot, cv::Point(px(points[i - 1].first), py(points[i - 1].second)) - origin, p - origin, bgr(n), 2,
                  cv::LINE_AA);
       }
-      cv::circle(plot, p - origin, 4, bgr(n), cv::FILLED, cv::LINE_AA);
+      drawSeriesMarker(plot, p - origin, n);
     }
   }
 
@@ -200,7 +210,7 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
     if (spec.series[n].lines) {
       cv::line(image, cv::Point(boxLeft + 6, row - 4), cv::Point(boxLeft + 28, row - 4), bgr(n), 2, cv::LINE_AA);
     }
-    cv::circle(image, cv::Point(boxLeft + 17, row - 4), 4, bgr(n), cv::FILLED, cv::LINE_AA);
+    drawSeriesMarker(image, cv::Point(boxLeft + 17, row - 4), n);
     cv::putText(image, spec.series[n].name, cv::Point(boxLeft + 34, row), kFont, kTextScale, kBlack, 1, cv::LINE_AA);
   }
 

@@ -1,7 +1,9 @@
 #pragma once
 // LineChart: a small 2D chart drawn with OpenCV into an RGB image (white background, framed plot area, x and y axes
 // with ticks at "nice" steps and numeric or category tick labels, axis labels, a title and a legend), for the
-// evaluation reports. Each series is a polyline with round markers (or markers only); NaN points are skipped.
+// evaluation reports. Each series is a polyline with markers (or markers only); NaN points are skipped. Series n has
+// colour n of a 7-colour cycle and, from the 8th series on, a marker shape of its own for each further cycle, so that
+// no two of the first 28 series look alike.
 
 #include <array>
 #include <cstdint>
@@ -35,6 +37,9 @@ struct ChartSpec {
   int height_px = 560;
 };
 
+/// The marker shape of a series.
+enum class ChartMarker { Disc, Square, Diamond, Triangle };
+
 /// Draws charts.
 class LineChart {
  public:
@@ -43,8 +48,10 @@ class LineChart {
   static Result<RgbImage> draw(const ChartSpec& spec);
   /// Draws the chart and writes it as an 8-bit RGB PNG (atomically); fails as draw() or on an unwritable path.
   static Status writePng(const ChartSpec& spec, const std::filesystem::path& path);
-  /// The colour of series n (a fixed, colour-blind-friendly cycle), RGB.
+  /// The colour of series n (a fixed, colour-blind-friendly cycle of 7), RGB.
   static std::array<std::uint8_t, 3> seriesColour(std::size_t n);
+  /// The marker of series n: a filled disc for the first 7, then one outline shape per further cycle of 7 colours.
+  static ChartMarker seriesMarker(std::size_t n);
 };
 
 }  // namespace fct

@@ -1,7 +1,10 @@
 // LineChart: a chart has the requested size, a white background, black axes and its series' colours; bad specs fail.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include "Evaluation/LineChart.h"
 
@@ -33,6 +36,19 @@ TEST(LineChart, DrawsAxesAndEverySeriesInItsColour) {
   EXPECT_TRUE(hasColour(image.value(), {0, 0, 0}));
   EXPECT_TRUE(hasColour(image.value(), fct::LineChart::seriesColour(0)));
   EXPECT_TRUE(hasColour(image.value(), fct::LineChart::seriesColour(1)));
+}
+
+TEST(LineChart, TheFirst28SeriesDifferInColourOrMarker) {
+  std::set<std::pair<std::array<std::uint8_t, 3>, fct::ChartMarker>> looks;
+  for (std::size_t n = 0; n < 28; ++n) looks.insert({fct::LineChart::seriesColour(n), fct::LineChart::seriesMarker(n)});
+  EXPECT_EQ(looks.size(), 28u);
+  EXPECT_EQ(fct::LineChart::seriesMarker(0), fct::ChartMarker::Disc);
+  EXPECT_EQ(fct::LineChart::seriesColour(7), fct::LineChart::seriesColour(0));
+  EXPECT_NE(fct::LineChart::seriesMarker(7), fct::ChartMarker::Disc);
+
+  fct::ChartSpec spec;  // twelve series, as the capture study's chart has, all drawn
+  for (int n = 0; n < 12; ++n) spec.series.push_back({fmt::format("s{}", n), {0.0, 1.0}, {0.1 * n, 0.1 * n + 1}, true});
+  EXPECT_TRUE(fct::LineChart::draw(spec).ok());
 }
 
 TEST(LineChart, CategoryAxisAcceptsIndicesOfItsCategories) {
