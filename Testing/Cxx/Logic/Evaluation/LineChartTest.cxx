@@ -1,4 +1,5 @@
-// LineChart: a chart has the requested size, a white background, black axes and its series' colours; bad specs fail.
+// LineChart: a chart has the requested size, a white background, black axes and its series' colours; series that
+// share a colour differ in marker; bad specs fail.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
