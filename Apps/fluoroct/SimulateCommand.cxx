@@ -29,7 +29,7 @@ namespace fct::cli {
 namespace {
 
 /// Options that only the physical model reads.
-constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", "--psf-px",     "--gain",
+constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", "--monochromatic-kev", "--psf-px",     "--gain",
                                          "--offset",      "--gamma",            "--pincushion", "--s-distortion-deg",
                                          "--vignetting",  "--collimator",       "--kwires",     "--screws",
                                          "--plate",       "--spheres",          "--sphere-pitch-mm",
@@ -89,6 +89,10 @@ void registerSimulateCommand(CLI::App& app, CommandAction& action) {
   FluoroscopyOptions& p = options->physical;
   command->add_option("--kvp", p.tubeVoltage_kvp, "physical: tube voltage, 50..120 kVp")->capture_default_str();
   command->add_option("--filtration-mm-al", p.filtration_mmAl, "physical: total tube filtration in mm Al")
+      ->capture_default_str();
+  command->add_option("--monochromatic-kev", p.monochromatic_keV,
+                      "physical: a monochromatic beam at this energy (10..150 keV) instead of the tube spectrum, so no "
+                      "beam hardening; 0 = the spectrum of --kvp and --filtration-mm-al")
       ->capture_default_str();
   command->add_option("--patient-extension-mm", p.patientExtension_mm,
                       "physical: the patient continues this far (mm, 0..1000) beyond the CT's end faces along its slice "

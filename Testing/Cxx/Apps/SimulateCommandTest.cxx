@@ -178,6 +178,17 @@ TEST(SimulateCommand, PhysicalModelWritesObjectsSpheresDistortionFieldAndADegrad
   EXPECT_NE(text.find("\"scatter_sigma_mm\": 25"), std::string::npos) << text;
 }
 
+TEST(SimulateCommand, MonochromaticBeamReplacesTheSpectrumAndIsRecorded) {
+  const auto dir = fct::test::workDir();
+  makeInputs(dir);
+  const auto out = dir / "mono";
+  const auto run = fct::test::runCli(simulateCommand(dir, out) + " --model physical --monochromatic-kev 60");
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  const std::string text = fileText(out / "simulation.json");
+  EXPECT_NE(text.find("\"monochromatic_kev\": 60"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"spectrum\": \"monochromatic 60 keV\""), std::string::npos) << text;
+}
+
 TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
   const auto dir = fct::test::workDir();
   makeInputs(dir);
@@ -188,7 +199,8 @@ TEST(SimulateCommand, PhysicalModelFailsCleanlyOnBadOptions) {
         std::string(" --model physical --pincushion 0.5"), std::string(" --model physical --method raycast"),
         std::string(" --kwires 2"), std::string(" --model xray"), std::string(" --model physical --ct-slice-mm 2"),
         std::string(" --model physical --patient-extension-mm -5"), std::string(" --model physical --scatter-to-primary 6"),
-        std::string(" --model physical --scatter-sigma-mm 0.5"), std::string(" --scatter-to-primary 0.1")}) {
+        std::string(" --model physical --scatter-sigma-mm 0.5"), std::string(" --scatter-to-primary 0.1"),
+        std::string(" --model physical --monochromatic-kev 5"), std::string(" --monochromatic-kev 60")}) {
     SCOPED_TRACE(extra);
     expectOneErrorLine(base + extra);
   }
