@@ -188,7 +188,7 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
         break;
       }
       case SimilarityMetric::Vlnc: {
-        auto metric = VlncSimilarity::create(pyramidLevel.image, selection);
+        auto metric = VlncSimilarity::create(pyramidLevel.image, selection, stage.vlncDomain);
         if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
         view.metric = std::make_unique<VlncSimilarity>(std::move(metric).value());
         break;

@@ -28,6 +28,8 @@ constexpr NameTable<LocalSearchMethod, 2> kLocalMethods{
     {{"simplex", LocalSearchMethod::Simplex}, {"bobyqa", LocalSearchMethod::Bobyqa}}};
 /// The exact methods a stage may name in "drr" (the Transgraph is built per view and case, not per stage).
 constexpr NameTable<DrrMethod, 2> kStageDrrMethods{{{"siddon", DrrMethod::Siddon}, {"raycast", DrrMethod::RayCast}}};
+constexpr NameTable<VlncDomain, 2> kVlncDomains{
+    {{"line_integral", VlncDomain::LineIntegral}, {"intensity", VlncDomain::Intensity}}};
 constexpr NameTable<PixelSetKind, 2> kPixelSets{
     {{"whole", PixelSetKind::WholeImage}, {"rois", PixelSetKind::Rois}}};
 
@@ -103,6 +105,12 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   stage.metric = parseName(reader, "metric", kMetrics);
   stage.level = reader.integer("level", 0);
   if (reader.ok() && stage.level > 7) reader.rejectKey("level", fmt::format("is {}; use 0 to 7", stage.level));
+  if (reader.has("domain")) {
+    stage.vlncDomain = parseName(reader, "domain", kVlncDomains);
+    if (reader.ok() && stage.metric != SimilarityMetric::Vlnc) {
+      reader.rejectKey("domain", "applies only with \"metric\": \"vlnc\"");
+    }
+  }
   optionalFlag(reader, "exact_drr", stage.exactDrr);
   optionalFlag(reader, "shift_prealign", stage.shiftPrealign);
   optionalFlag(reader, "metal_review", stage.metalReview);
@@ -283,6 +291,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
                                      {"metric", metricName(s.metric)},
                                      {"level", s.level},
                                      {"exact_drr", s.exactDrr}};
+    if (s.vlncDomain != VlncDomain::LineIntegral) stageJson["domain"] = nameOf(s.vlncDomain, kVlncDomains);
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
     if (s.shiftPrealign) stageJson["shift_prealign"] = true;
@@ -320,7 +329,10 @@ RegistrationSchedule RegistrationSchedule::withAblation(const RegistrationAblati
   for (RegistrationStage& stage : result.stages) {
     if (ablation.noDynamicRois) stage.pixels.kind = PixelSetKind::WholeImage;
     if (ablation.noPyramid) stage.level = 0;
-    if (ablation.nccOnly) stage.metric = SimilarityMetric::Ncc;
+    if (ablation.nccOnly) {
+      stage.metric = SimilarityMetric::Ncc;
+      stage.vlncDomain = VlncDomain::LineIntegral;  // NCC compares line integrals
+    }
     if (ablation.localOnly) stage.search = SearchStrategy::Local;
     if (ablation.cmaesForGenetic && stage.search == SearchStrategy::Genetic) stage.search = SearchStrategy::CmaEs;
   }

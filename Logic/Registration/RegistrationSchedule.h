@@ -19,6 +19,7 @@
 #include "Search/CmaEsOptimizer.h"
 #include "Search/GeneticSearchOptimizer.h"
 #include "Search/LocalPoseOptimizer.h"
+#include "Similarity/VlncSimilarity.h"
 
 namespace fct {
 
@@ -57,6 +58,8 @@ struct RegistrationStage {
   std::string name;
   SimilarityMetric metric = SimilarityMetric::Ncc;
   int level = 0;                   ///< pyramid level: 0 = full resolution, 2 = 1:16 pixels
+  /// VLNC: compare line integrals (the paper's) or detector intensities (invariant to a scatter haze; JSON "domain").
+  VlncDomain vlncDomain = VlncDomain::LineIntegral;
   /// Render with the case's exact renderer even when it has per-view Transgraphs (whose interpolation smooths detail
   /// finer than the table spacing: measured too coarse for the full-resolution stage, see README).
   bool exactDrr = false;

@@ -8,13 +8,16 @@
 
 namespace fct {
 
-Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiSelection& selection) {
+Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiSelection& selection,
+                                              VlncDomain domain) {
   const int w = selection.windowSize;
   if (selection.windows.empty() || w <= 0) {
     return fail("VLNC needs at least one window; the ROI selection is empty (lower the threshold or raise the "
                 "target fraction)");
   }
   VlncSimilarity metric(xray.cols, xray.rows);
+  metric.m_domain = domain;
+  const bool intensity = domain == VlncDomain::Intensity;
   metric.m_windowPixels = static_cast<std::size_t>(w) * w;
   std::vector<float> values(metric.m_windowPixels);
   PixelIndexList indices(metric.m_windowPixels);
@@ -29,7 +32,8 @@ Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiS
     for (int r = window.row0; r < window.row0 + w; ++r) {
       for (int c = window.col0; c < window.col0 + w; ++c, ++k) {
         indices[k] = r * xray.cols + c;
-        values[k] = xray.pixels[static_cast<std::size_t>(indices[k])];
+        const float lineIntegral = xray.pixels[static_cast<std::size_t>(indices[k])];
+        values[k] = intensity ? std::exp(-lineIntegral) : lineIntegral;
       }
     }
     const double norm = NccAccumulator::centreInPlace(values.data(), values.size());
@@ -54,14 +58,20 @@ Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiS
 double VlncSimilarity::compare(const FloatImage& drr) const {
   const float* d = drr.pixels.data();
   const std::size_t m = m_windowPixels;
-  double vlnc = 0.0;
-  for (std::size_t window = 0; window < m_weights.size(); ++window) {
-    const std::int32_t* index = m_pixels.data() + window * m;
-    const float* x = m_xrayCentred.data() + window * m;
-    NccAccumulator sums(d[index[0]]);
-    for (std::size_t i = 0; i < m; ++i) sums.add(x[i], d[index[i]]);
-    vlnc += m_weights[window] * sums.correlation(m_xrayNorms[window], m);
-  }
+  // The same sums in either domain; `toDomain` maps a DRR line integral to the compared value.
+  const auto weightedSum = [&](auto toDomain) {
+    double vlnc = 0.0;
+    for (std::size_t window = 0; window < m_weights.size(); ++window) {
+      const std::int32_t* index = m_pixels.data() + window * m;
+      const float* x = m_xrayCentred.data() + window * m;
+      NccAccumulator sums(toDomain(d[index[0]]));
+      for (std::size_t i = 0; i < m; ++i) sums.add(x[i], toDomain(d[index[i]]));
+      vlnc += m_weights[window] * sums.correlation(m_xrayNorms[window], m);
+    }
+    return vlnc;
+  };
+  const double vlnc = m_domain == VlncDomain::Intensity ? weightedSum([](float p) { return std::exp(-p); })
+                                                        : weightedSum([](float p) { return p; });
   return std::clamp(vlnc, -1.0, 1.0);  // NaN stays NaN
 }
 

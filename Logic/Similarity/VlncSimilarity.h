@@ -5,6 +5,11 @@
 // Windows where the X-ray is constant have weight 0 and are skipped; a window where the DRR is constant has
 // NCC_w = 0. VLNC is in [-1, 1] and invariant to a gain and offset of either image (and to a different offset per
 // window). If every window's X-ray is constant, VLNC is 0 for every DRR.
+//
+// Both images are line integrals p (the DRR's sense). VLNC compares them as they are (the paper's: each window is
+// also invariant to a contrast scale, a first-order beam hardening), or as detector intensities exp(-p): each window
+// is then invariant to an added constant (a scatter haze, which in the line-integral sense bends dark windows'
+// edges), and the weights, variances of intensities, favour the bright windows, which have the most photons.
 
 #include <cstddef>
 #include <vector>
@@ -16,12 +21,20 @@
 
 namespace fct {
 
+/// The values VLNC compares.
+enum class VlncDomain {
+  LineIntegral,  ///< the line integrals p = -ln(I / I0) (the paper's)
+  Intensity,     ///< the detector intensities exp(-p), relative to I0
+};
+
 /// VLNC over fixed windows of one view.
 class VlncSimilarity final : public ImageSimilarity {
  public:
-  /// Prepares the X-ray side over the windows of `selection` (their position and size; weights are recomputed from
-  /// `xray`). Fails on no window or a window not inside the image. All-constant windows give a warning.
-  static Result<VlncSimilarity> create(const FloatImage& xray, const RoiSelection& selection);
+  /// Prepares the X-ray side (line integrals) over the windows of `selection` (their position and size; weights are
+  /// recomputed from `xray` in `domain`). Fails on no window or a window not inside the image. All-constant windows
+  /// give a warning.
+  static Result<VlncSimilarity> create(const FloatImage& xray, const RoiSelection& selection,
+                                       VlncDomain domain = VlncDomain::LineIntegral);
 
   std::string name() const override { return "VLNC"; }
   /// Number of windows with a nonzero weight.
@@ -31,9 +44,10 @@ class VlncSimilarity final : public ImageSimilarity {
   VlncSimilarity(int xrayCols, int xrayRows) : ImageSimilarity(xrayCols, xrayRows) {}
   double compare(const FloatImage& drr) const override;
 
+  VlncDomain m_domain = VlncDomain::LineIntegral;
   std::size_t m_windowPixels = 0;    ///< w*w
   PixelIndexList m_pixels;           ///< window by window, m_windowPixels each
-  std::vector<float> m_xrayCentred;  ///< X-ray values minus their window's mean, same layout
+  std::vector<float> m_xrayCentred;  ///< X-ray values (in m_domain) minus their window's mean, same layout
   std::vector<double> m_xrayNorms;   ///< per window
   std::vector<double> m_weights;     ///< per window, summing to 1
 };

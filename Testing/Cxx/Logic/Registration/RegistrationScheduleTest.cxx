@@ -74,6 +74,27 @@ TEST(RegistrationSchedule, JsonRoundTripGivesTheSameSchedule) {
   }
 }
 
+TEST(RegistrationSchedule, VlncDomainIsReadWrittenAndResetByTheNccOnlyAblation) {
+  const auto parsed = RegistrationSchedule::fromJson(
+      nlohmann::json::parse(R"({"name": "x", "stages": [{"name": "s", "metric": "vlnc", "level": 1,
+          "domain": "intensity", "pixels": {"set": "rois"}, "search": {"strategy": "local", "max_evaluations": 10}}]})"),
+      "test.json");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().stages[0].vlncDomain, fct::VlncDomain::Intensity);
+  const auto json = parsed.value().toJson();
+  EXPECT_EQ(json["stages"][0]["domain"], "intensity");
+  const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(again.value().toJson(), json);
+  EXPECT_FALSE(RegistrationSchedule::builtin("clinical").value().toJson()["stages"][2].contains("domain"))
+      << "line integrals are the default and are not written";
+  fct::RegistrationAblation nccOnly;
+  nccOnly.nccOnly = true;
+  const auto ablated = parsed.value().withAblation(nccOnly);
+  EXPECT_EQ(ablated.stages[0].vlncDomain, fct::VlncDomain::LineIntegral);
+  EXPECT_TRUE(RegistrationSchedule::fromJson(ablated.toJson(), "ablated").ok()) << "an NCC stage has no domain";
+}
+
 TEST(RegistrationSchedule, ReadsAUserFileAndResolvesNames) {
   const auto dir = fct::test::scratchDir();
   const auto path = dir / "mine.json";
@@ -121,6 +142,10 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
        "shift_prealign"},
       {stageHead + R"("metric": "vlnc", "level": 2, "metal_review": "on", "pixels": {"set": "whole"}, )" + search + "]}",
        "metal_review"},
+      {stageHead + R"("metric": "vlnc", "level": 2, "domain": "log", "pixels": {"set": "whole"}, )" + search + "]}",
+       "domain"},
+      {stageHead + R"("metric": "ncc", "level": 2, "domain": "intensity", "pixels": {"set": "whole"}, )" + search + "]}",
+       "domain"},
       {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"step_deg": 10}, "pixels": {"set": "whole"}, )" +
            search + "]}",
        "max_deg"},

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "Similarity/DynamicRoiSelector.h"
@@ -32,6 +33,33 @@ TEST(VlncSimilarity, IdenticalIsOneNegatedIsMinusOneAndLocalOffsetsAreIgnored) {
     for (int c = 0; c < xray.cols; ++c) uneven.at(c, r) = (1.0f + 0.1f * (c / 7)) * xray.at(c, r) + 3.0f * (r / 7);
   }
   EXPECT_NEAR(vlnc.value().evaluate(uneven).value(), 1.0, 1e-6);
+}
+
+TEST(VlncSimilarity, IntensityDomainIgnoresAHazeThatBendsLineIntegrals) {
+  // A DRR d of smooth line integrals from 1 to 7 (a thick patient) and the X-ray of the same patient with a scatter
+  // haze: I = 0.8 exp(-d) + 0.01, whose line integrals -ln(I) are not an affine map of d within a window.
+  fct::FloatImage drr = fct::FloatImage::filled(128, 112);
+  for (int r = 0; r < drr.rows; ++r) {
+    for (int c = 0; c < drr.cols; ++c) drr.at(c, r) = 4.0f + 3.0f * std::sin(0.2f * c) * std::cos(0.15f * r);
+  }
+  fct::FloatImage hazy = drr;
+  for (float& p : hazy.pixels) p = -std::log(0.8f * std::exp(-p) + 0.01f);
+  const fct::RoiSelection rois = roisOf(drr, 0.15);
+  const auto intensity = fct::VlncSimilarity::create(hazy, rois, fct::VlncDomain::Intensity);
+  const auto lineIntegral = fct::VlncSimilarity::create(hazy, rois, fct::VlncDomain::LineIntegral);
+  ASSERT_TRUE(intensity.ok()) << intensity.error();
+  ASSERT_TRUE(lineIntegral.ok()) << lineIntegral.error();
+  EXPECT_NEAR(intensity.value().evaluate(drr).value(), 1.0, 1e-5);
+  EXPECT_LT(lineIntegral.value().evaluate(drr).value(), 0.99);
+  // Without haze a perfect match scores 1, and a DRR moved by 3 pixels scores clearly less.
+  const auto clean = fct::VlncSimilarity::create(drr, rois, fct::VlncDomain::Intensity);
+  ASSERT_TRUE(clean.ok());
+  EXPECT_NEAR(clean.value().evaluate(drr).value(), 1.0, 1e-6);
+  fct::FloatImage moved = drr;
+  for (int r = 0; r < drr.rows; ++r) {
+    for (int c = 0; c < drr.cols; ++c) moved.at(c, r) = drr.at(std::min(c + 3, drr.cols - 1), r);
+  }
+  EXPECT_LT(clean.value().evaluate(moved).value(), 0.97);
 }
 
 TEST(VlncSimilarity, IsTheVarianceWeightedSumOfWindowNccs) {
