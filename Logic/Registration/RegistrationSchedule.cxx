@@ -291,7 +291,9 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
                                      {"metric", metricName(s.metric)},
                                      {"level", s.level},
                                      {"exact_drr", s.exactDrr}};
-    if (s.vlncDomain != VlncDomain::LineIntegral) stageJson["domain"] = nameOf(s.vlncDomain, kVlncDomains);
+    if (s.metric == SimilarityMetric::Vlnc && s.vlncDomain != VlncDomain::LineIntegral) {
+      stageJson["domain"] = nameOf(s.vlncDomain, kVlncDomains);  // other metrics compare line integrals
+    }
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
     if (s.shiftPrealign) stageJson["shift_prealign"] = true;
