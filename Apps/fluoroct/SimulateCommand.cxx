@@ -29,12 +29,14 @@ namespace fct::cli {
 namespace {
 
 /// Options that only the physical model reads.
-constexpr const char* kPhysicalOnly[] = {"--kvp",         "--filtration-mm-al", "--monochromatic-kev", "--psf-px",     "--gain",
-                                         "--offset",      "--gamma",            "--pincushion", "--s-distortion-deg",
-                                         "--vignetting",  "--collimator",       "--kwires",     "--screws",
-                                         "--plate",       "--spheres",          "--sphere-pitch-mm",
-                                         "--fixed-exposure", "--gas-pockets", "--grid-pitch-mm",
-                                         "--patient-extension-mm", "--scatter-to-primary", "--scatter-sigma-mm"};
+constexpr const char* kPhysicalOnly[] = {"--kvp",          "--filtration-mm-al",     "--monochromatic-kev",
+                                         "--psf-px",       "--gain",                 "--offset",
+                                         "--gamma",        "--pincushion",           "--s-distortion-deg",
+                                         "--vignetting",   "--collimator",           "--kwires",
+                                         "--screws",       "--plate",                "--spheres",
+                                         "--sphere-pitch-mm", "--fixed-exposure",    "--gas-pockets",
+                                         "--grid-pitch-mm", "--patient-extension-mm", "--scatter-to-primary",
+                                         "--scatter-sigma-mm"};
 /// Options that only the DRR model reads.
 constexpr const char* kDrrOnly[] = {"--method", "--i0"};
 

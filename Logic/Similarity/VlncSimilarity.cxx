@@ -8,6 +8,13 @@
 
 namespace fct {
 
+namespace {
+
+/// The detector intensity relative to I0 of a line integral p: exp(-p).
+float intensityOf(float lineIntegral) { return std::exp(-lineIntegral); }
+
+}  // namespace
+
 Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiSelection& selection,
                                               VlncDomain domain) {
   const int w = selection.windowSize;
@@ -33,7 +40,7 @@ Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiS
       for (int c = window.col0; c < window.col0 + w; ++c, ++k) {
         indices[k] = r * xray.cols + c;
         const float lineIntegral = xray.pixels[static_cast<std::size_t>(indices[k])];
-        values[k] = intensity ? std::exp(-lineIntegral) : lineIntegral;
+        values[k] = intensity ? intensityOf(lineIntegral) : lineIntegral;
       }
     }
     const double norm = NccAccumulator::centreInPlace(values.data(), values.size());
@@ -70,7 +77,7 @@ double VlncSimilarity::compare(const FloatImage& drr) const {
     }
     return vlnc;
   };
-  const double vlnc = m_domain == VlncDomain::Intensity ? weightedSum([](float p) { return std::exp(-p); })
+  const double vlnc = m_domain == VlncDomain::Intensity ? weightedSum([](float p) { return intensityOf(p); })
                                                         : weightedSum([](float p) { return p; });
   return std::clamp(vlnc, -1.0, 1.0);  // NaN stays NaN
 }
