@@ -240,6 +240,7 @@ struct StageStart {
   /// DRRs rendered before the search: the metal review's and the rotation sweep's grid ranking (its own objective)
   long preSearchDrrs = 0;
   int metalPiecesGivenBack = 0;  ///< metal-mask pieces the metal review gave back
+  HazeRemovalSummary haze;       ///< what the haze removal did (nothing without one)
 };
 
 /// The stage's similarity at `current` (pose parameters), or `known` when that is not NaN. Fails, naming the stage.
@@ -264,6 +265,21 @@ Result<bool> remakeObjectiveIfFar(RegistrationCase& registrationCase, const Regi
   objective = std::move(remade).value();
   T_objective = T_at;
   return true;
+}
+
+/// Makes the objectives of stages `first` onward again at T_at (after their X-rays or masks changed) and moves their
+/// T_objectives there. Fails with the failing stage's message.
+Status remakeObjectivesFrom(RegistrationCase& registrationCase, const RegistrationSchedule& schedule, std::size_t first,
+                            const RegistrationAblation& ablation, bool useViewRenderers, const Eigen::Isometry3d& T_at,
+                            std::vector<RegistrationObjective>& objectives,
+                            std::vector<Eigen::Isometry3d>& T_objectives) {
+  for (std::size_t j = first; j < schedule.stages.size(); ++j) {
+    auto rebuilt = objectiveAt(registrationCase, schedule.stages[j], ablation, useViewRenderers, T_at);
+    if (!rebuilt) return fail(rebuilt.error());
+    objectives[j] = std::move(rebuilt).value();
+    T_objectives[j] = T_at;
+  }
+  return Ok{};
 }
 
 /// The stage's rotation sweep from `current`: fills start.sweepSeeds for a genetic search, or moves `current` to the
@@ -315,6 +331,9 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   report.prealignShift_world_mm = start.prealignShift_world_mm;
   report.rotationSweepSeeds = static_cast<int>(start.sweepSeeds.size());
   report.metalPiecesGivenBack = start.metalPiecesGivenBack;
+  report.hazeViewsCorrected = start.haze.viewsCorrected;
+  report.hazeFraction = start.haze.largestHazeFraction;
+  report.hazeViewsKept = start.haze.viewsKept;
 
   RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startSimilarity);
   std::string renderError;
@@ -365,6 +384,12 @@ std::string stageStartNote(const StageReport& report) {
     notes.push_back(fmt::format("{} metal-mask piece{} the DRR explains compared as anatomy",
                                 report.metalPiecesGivenBack, report.metalPiecesGivenBack == 1 ? "" : "s"));
   }
+  if (report.hazeViewsCorrected > 0) {
+    notes.push_back(fmt::format("haze removed from {} view{} (up to {:.0f} % of a view's signal)",
+                                report.hazeViewsCorrected, report.hazeViewsCorrected == 1 ? "" : "s",
+                                100.0 * report.hazeFraction));
+  }
+  for (const std::string& kept : report.hazeViewsKept) notes.push_back("haze not removed from " + kept);
   return fmt::format("{}", fmt::join(notes, "; "));
 }
 
@@ -390,6 +415,8 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
   result.rotationCentre_ct_mm = registrationCase.rotationCentre_ct_mm();
   for (std::size_t v = 0; v < registrationCase.viewCount(); ++v) result.viewNames.push_back(registrationCase.viewName(v));
 
+  // A run compares the X-rays as prepared: an earlier run's haze removal does not carry over.
+  if (const Status restored = registrationCase.restorePreparedXrays(); !restored) return fail(restored.error());
   auto objectives = createObjectives(registrationCase, schedule, options.ablation, useViewRenderers, T_initial);
   if (!objectives) return fail(objectives.error());
   std::vector<Eigen::Isometry3d> T_objectives(schedule.stages.size(), T_initial);  // where each objective was made
@@ -412,13 +439,21 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
       stageStart.metalPiecesGivenBack = review.value().piecesGivenBack;
       stageStart.preSearchDrrs += review.value().drrs;
       if (review.value().piecesGivenBack > 0) {  // the masks changed: the stages from here on select their pixels again
-        for (std::size_t j = i; j < schedule.stages.size(); ++j) {
-          auto rebuilt =
-              objectiveAt(registrationCase, schedule.stages[j], options.ablation, useViewRenderers, T_review);
-          if (!rebuilt) return fail(rebuilt.error());
-          objectives.value()[j] = std::move(rebuilt).value();
-          T_objectives[j] = T_review;
-        }
+        const Status rebuilt = remakeObjectivesFrom(registrationCase, schedule, i, options.ablation, useViewRenderers,
+                                                    T_review, objectives.value(), T_objectives);
+        if (!rebuilt) return fail(rebuilt.error());
+      }
+    }
+    if (stage.hazeSigma_mm > 0.0) {
+      const Eigen::Isometry3d T_haze = registrationCase.poseTransform(current);
+      auto removed = registrationCase.removeHaze(T_haze, stage.hazeSigma_mm);
+      if (!removed) return fail(fmt::format("stage '{}': {}", stage.name, removed.error()));
+      stageStart.haze = removed.value();
+      stageStart.preSearchDrrs += removed.value().drrs;
+      if (removed.value().viewsCorrected > 0) {  // the X-rays changed: the stages from here on select their pixels again
+        const Status rebuilt = remakeObjectivesFrom(registrationCase, schedule, i, options.ablation, useViewRenderers,
+                                                    T_haze, objectives.value(), T_objectives);
+        if (!rebuilt) return fail(rebuilt.error());
       }
     }
     if (stage.shiftPrealign) {

@@ -68,12 +68,18 @@ struct StageReport {
   int rotationSweepSeeds = 0;
   /// Metal-mask pieces its metal review gave back to the comparison as anatomy (0 without a review or when none).
   int metalPiecesGivenBack = 0;
+  /// Views whose X-ray its haze removal corrected (0 without one), and the largest mean share |s|/I of a view's signal
+  /// its haze term changed.
+  int hazeViewsCorrected = 0;
+  double hazeFraction = 0.0;
+  /// Per view its haze removal left as it was: "view 'NAME': why" (the fit failed: a pose far off).
+  std::vector<std::string> hazeViewsKept;
   bool cancelled = false;
   Eigen::Isometry3d T_world_from_ct = Eigen::Isometry3d::Identity();  ///< the stage's final pose (LPS mm)
 };
-/// What happened before a stage's search, "" when nothing did: "start moved N mm by shift pre-alignment" and
-/// "K rotation sweep poses searched beside the start" / "start moved to the rotation sweep's best pose". One wording
-/// for the CLI and the Studio.
+/// What happened before a stage's search, "" when nothing did: "start moved N mm by shift pre-alignment",
+/// "K rotation sweep poses searched beside the start" / "start moved to the rotation sweep's best pose", the metal
+/// review's and the haze removal's outcome. One wording for the CLI and the Studio.
 std::string stageStartNote(const StageReport& report);
 
 /// Receives each stage's report as the stage ends (called on the registration's thread).

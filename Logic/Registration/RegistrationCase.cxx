@@ -1,6 +1,7 @@
 #include "Registration/RegistrationCase.h"
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -11,6 +12,7 @@
 #include "Geometry/RigidPose.h"
 #include "Search/PoseOptimizer.h"
 #include "XrayPrep/MetalMaskReview.h"
+#include "XrayPrep/XrayHazeCorrector.h"
 
 namespace fct {
 
@@ -61,7 +63,8 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
     auto prepared = prepareXray(view.name, view.camera, view.xray, preparation);
     if (!prepared) return fail(prepared.error());
     result.m_views.push_back(
-        View{view.name, view.camera, std::move(preparation), std::move(prepared).value(), {}, result.m_renderer, nullptr});
+        View{view.name, view.camera, std::move(preparation), std::move(prepared).value(), std::nullopt, {},
+             result.m_renderer, nullptr});
   }
 
   if (cancelled()) return fail(kCancelled);
@@ -129,7 +132,76 @@ Status RegistrationCase::replaceXray(std::size_t v, const XrayImage& xray) {
   auto prepared = prepareXray(view.name, view.camera, xray, view.preparation);
   if (!prepared) return fail(prepared.error());
   view.prepared = std::move(prepared).value();
+  view.preparedImage.reset();
   view.selectors.clear();
+  return Ok{};
+}
+
+Result<HazeRemovalSummary> RegistrationCase::removeHaze(const Eigen::Isometry3d& T_world_from_ct,
+                                                        double hazeSigma_mm) {
+  if (!(hazeSigma_mm > 0.0) || !std::isfinite(hazeSigma_mm)) {
+    return fail(fmt::format("haze removal: the haze's smoothness must be a positive number of mm, got {}", hazeSigma_mm));
+  }
+  auto cutFaces = CutFaceRayMask::create(*m_drrVolume, kHazeFitCutFaceMargin_mm);
+  if (!cutFaces) return fail("haze removal: " + cutFaces.error());
+  // Each view's fit, in parallel: a failed render or mask fails the call, a failed fit keeps that view's X-ray.
+  std::vector<Status> statuses(m_views.size(), Ok{});
+  std::vector<std::optional<Result<HazeCorrection>>> fits(m_views.size());
+  tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
+    const View& view = m_views[v];
+    auto drr = m_renderer->render(view.camera, T_world_from_ct, 0);
+    if (!drr) {
+      statuses[v] = fail(fmt::format("view '{}': haze removal: {}", view.name, drr.error()));
+      return;
+    }
+    const PyramidLevel& full = view.prepared.pyramid.level(0);
+    ValidMask fitMask = full.mask;
+    if (const Status clear = fitMask.intersect(cutFaces.value().compute(view.camera, T_world_from_ct)); !clear) {
+      statuses[v] = fail(fmt::format("view '{}': haze removal: {}", view.name, clear.error()));
+      return;
+    }
+    fits[v] = XrayHazeCorrector::correct(view.preparedImage ? *view.preparedImage : full.image, drr.value(), fitMask,
+                                         hazeSigma_mm / view.camera.intrinsics().pixelSpacing_mm.mean());
+  });
+  HazeRemovalSummary summary;
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    if (!statuses[v]) return fail(statuses[v].error());
+  }
+  summary.drrs = static_cast<int>(m_views.size());
+  std::vector<std::optional<XrayPyramid>> pyramids(m_views.size());  // all built before any view changes
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    const Result<HazeCorrection>& fit = *fits[v];
+    if (!fit) {
+      summary.viewsKept.push_back(fmt::format("view '{}': {}", m_views[v].name, fit.error()));
+      continue;
+    }
+    auto pyramid = XrayPyramid::build(fit.value().lineIntegrals, m_views[v].prepared.pyramid.level(0).mask,
+                                      m_views[v].camera, levelCount());
+    if (!pyramid) return fail(fmt::format("view '{}': haze removal: pyramid: {}", m_views[v].name, pyramid.error()));
+    pyramids[v] = std::move(pyramid).value();
+    ++summary.viewsCorrected;
+    summary.largestHazeFraction = std::max(summary.largestHazeFraction, fit.value().meanHazeFraction);
+  }
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
+    if (!pyramids[v]) continue;
+    View& view = m_views[v];
+    if (!view.preparedImage) view.preparedImage = view.prepared.pyramid.level(0).image;
+    view.prepared.pyramid = std::move(*pyramids[v]);
+    view.selectors.clear();
+  }
+  return summary;
+}
+
+Status RegistrationCase::restorePreparedXrays() {
+  for (View& view : m_views) {
+    if (!view.preparedImage) continue;
+    auto pyramid = XrayPyramid::build(*view.preparedImage, view.prepared.pyramid.level(0).mask, view.camera,
+                                      levelCount());
+    if (!pyramid) return fail(fmt::format("view '{}': restoring the prepared X-ray: {}", view.name, pyramid.error()));
+    view.prepared.pyramid = std::move(pyramid).value();
+    view.preparedImage.reset();
+    view.selectors.clear();
+  }
   return Ok{};
 }
 

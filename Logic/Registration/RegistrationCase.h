@@ -60,6 +60,14 @@ struct MetalReviewSummary {
   int drrs = 0;             ///< full-resolution DRRs rendered (one per view with metal)
 };
 
+/// What RegistrationCase::removeHaze did.
+struct HazeRemovalSummary {
+  int viewsCorrected = 0;                  ///< views whose X-ray was corrected
+  int drrs = 0;                            ///< full-resolution DRRs rendered (one per view)
+  double largestHazeFraction = 0.0;        ///< the largest mean share of a view's signal the haze term changed
+  std::vector<std::string> viewsKept;      ///< per view left as it was: "view 'NAME': why"
+};
+
 /// A prepared registration problem: CT, renderer and views.
 class RegistrationCase {
  public:
@@ -128,6 +136,19 @@ class RegistrationCase {
   /// the pieces given back (0: nothing changed) and the DRRs rendered (one per view with metal). Fails, naming the view
   /// and leaving it as it was, when its DRR cannot be rendered or the review fails.
   Result<MetalReviewSummary> reviewMetalMasks(const Eigen::Isometry3d& T_world_from_ct);
+  /// Removes a smooth haze (scatter, glare) and gain from every view's X-ray (XrayHazeCorrector) with a DRR of the CT
+  /// at T_world_from_ct (a pose near the truth, e.g. after the global stage), fitted over the valid pixels clear of the
+  /// CT's cut faces; `hazeSigma_mm` is the haze's smoothness on the detector (Gaussian sigma, mm). A corrected view gets
+  /// its pyramid rebuilt and its ROI statistics dropped. The correction is made from the X-ray as prepared, so a second
+  /// call replaces the first; restorePreparedXrays() undoes it. A view whose fit fails (a pose far off) keeps its
+  /// X-ray and is named in the summary. Fails, naming the view, when a DRR cannot be rendered or a pyramid rebuilt.
+  Result<HazeRemovalSummary> removeHaze(const Eigen::Isometry3d& T_world_from_ct, double hazeSigma_mm);
+  /// Gives every view corrected by removeHaze() its X-ray as prepared back (its current masks kept); nothing to do when
+  /// none was corrected. Fails, naming the view, when a pyramid cannot be rebuilt.
+  Status restorePreparedXrays();
+  /// Rays passing within this distance of the CT's cut faces (mm) are not used by the haze fit: beyond them the X-ray
+  /// shows anatomy the DRR lacks.
+  static constexpr double kHazeFitCutFaceMargin_mm = 5.0;
   /// Rays passing within this distance of the CT's cut faces (mm) are not judged by the metal review: beyond them the
   /// X-ray shows anatomy the DRR lacks.
   static constexpr double kMetalReviewCutFaceMargin_mm = 5.0;
@@ -169,6 +190,7 @@ class RegistrationCase {
     Camera camera;
     XrayPreparationOptions preparation;  ///< the case's options with the view's spheres
     PreparedXray prepared;
+    std::optional<FloatImage> preparedImage;  ///< level 0 as prepared while removeHaze() has replaced it
     std::map<std::pair<int, int>, DynamicRoiSelector> selectors;  ///< by (level, window size)
     std::shared_ptr<const DrrRenderer> renderer;                  ///< the view's renderer (see renderer(v))
     const TransgraphRenderer* transgraph = nullptr;               ///< the same renderer when it is a Transgraph

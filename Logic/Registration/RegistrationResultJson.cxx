@@ -109,6 +109,21 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
   if (reader.has("metal_pieces_given_back")) {
     stage.metalPiecesGivenBack = reader.integer("metal_pieces_given_back", 0);
   }
+  if (reader.has("haze_views_corrected")) {
+    stage.hazeViewsCorrected = reader.integer("haze_views_corrected", 0);
+    stage.hazeFraction = reader.number("haze_fraction");
+  }
+  if (const nlohmann::json* kept = reader.has("haze_views_kept")
+                                       ? reader.array("haze_views_kept", "a list of texts (one per view)")
+                                       : nullptr) {
+    for (const nlohmann::json& text : *kept) {
+      if (!text.is_string()) {
+        reader.rejectKey("haze_views_kept", fmt::format("holds {}; use texts", JsonReader::describe(text)));
+        break;
+      }
+      stage.hazeViewsKept.push_back(text.get<std::string>());
+    }
+  }
   stage.cancelled = reader.boolean("cancelled");
   parent.adoptError(reader);
   return stage;
@@ -140,6 +155,11 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
     }
     if (s.rotationSweepSeeds > 0) stages.back()["rotation_sweep_seeds"] = s.rotationSweepSeeds;
     if (s.metalPiecesGivenBack > 0) stages.back()["metal_pieces_given_back"] = s.metalPiecesGivenBack;
+    if (s.hazeViewsCorrected > 0) {
+      stages.back()["haze_views_corrected"] = s.hazeViewsCorrected;
+      stages.back()["haze_fraction"] = s.hazeFraction;
+    }
+    if (!s.hazeViewsKept.empty()) stages.back()["haze_views_kept"] = s.hazeViewsKept;
   }
   ordered_json initialPose = ordered_json::object();
   initialPose["T_world_from_ct"] = JsonDocument::array(result.T_initial.matrix());

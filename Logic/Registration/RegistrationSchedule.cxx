@@ -114,6 +114,10 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
   optionalFlag(reader, "exact_drr", stage.exactDrr);
   optionalFlag(reader, "shift_prealign", stage.shiftPrealign);
   optionalFlag(reader, "metal_review", stage.metalReview);
+  optionalNumber(reader, "haze_sigma_mm", stage.hazeSigma_mm);
+  if (reader.ok() && reader.has("haze_sigma_mm") && !(stage.hazeSigma_mm >= 1.0 && stage.hazeSigma_mm <= 200.0)) {
+    reader.rejectKey("haze_sigma_mm", fmt::format("is {}; use 1 to 200 mm on the detector", stage.hazeSigma_mm));
+  }
   if (const nlohmann::json* sweep = reader.find("rotation_sweep")) readRotationSweep(*sweep, where, reader, stage.rotationSweep);
   if (reader.has("drr")) stage.drrMethod = parseName(reader, "drr", kStageDrrMethods);
   optionalNumber(reader, "drr_step_voxels", stage.drrStep_voxels);
@@ -298,6 +302,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
     if (s.shiftPrealign) stageJson["shift_prealign"] = true;
     if (s.metalReview) stageJson["metal_review"] = true;
+    if (s.hazeSigma_mm > 0.0) stageJson["haze_sigma_mm"] = s.hazeSigma_mm;
     if (s.rotationSweep.maxRotation_deg > 0.0) {
       stageJson["rotation_sweep"] = {{"max_deg", s.rotationSweep.maxRotation_deg},
                                      {"step_deg", s.rotationSweep.step_deg},

@@ -77,6 +77,10 @@ struct RegistrationStage {
   /// Before the stage, give back the metal-mask pieces that a DRR at the stage's start explains (anatomy taken for
   /// metal, RegistrationCase::reviewMetalMasks); for a stage that starts near the truth, after the global search.
   bool metalReview = false;
+  /// Before the stage (after the metal review), remove a smooth haze of this Gaussian sigma on the detector (mm) from
+  /// every X-ray with a DRR at the stage's start (RegistrationCase::removeHaze); the stages after it compare the
+  /// corrected X-rays too. 0: off. For a stage that starts near the truth (JSON "haze_sigma_mm").
+  double hazeSigma_mm = 0.0;
   /// Before the search (after the shift pre-alignment), look around the start's rotation on a coarse grid; the poses
   /// that beat the start are refined beside it (genetic) or replace it (local, CMA-ES: the best one).
   RotationSweepSpec rotationSweep;

@@ -58,6 +58,9 @@ fct::RegistrationResult fullResult() {
   stage.prealignShift_world_mm = {12.5, -3.25, 0.5};
   stage.rotationSweepSeeds = 2;
   stage.metalPiecesGivenBack = 3;
+  stage.hazeViewsCorrected = 1;
+  stage.hazeFraction = 0.125;
+  stage.hazeViewsKept = {"view 'lateral': haze removal: the DRR is constant over the valid pixels"};
   r.stages = {stage};
   r.totalSeconds = 7.5;
   r.totalDrrs = 4000;
@@ -105,6 +108,8 @@ TEST(RegistrationResultJson, WritesEveryStageWithKeptFractionsByViewName) {
   EXPECT_FALSE(stages[0].contains("prealign_shift_mm")) << "written only for a stage whose start it moved";
   EXPECT_FALSE(stages[0].contains("rotation_sweep_seeds")) << "written only for a stage its rotation sweep seeded";
   EXPECT_FALSE(stages[0].contains("metal_pieces_given_back")) << "written only for a stage whose metal review gave back";
+  EXPECT_FALSE(stages[0].contains("haze_views_corrected")) << "written only for a stage whose haze removal corrected";
+  EXPECT_FALSE(stages[0].contains("haze_views_kept")) << "written only for a stage whose haze removal kept a view";
 }
 
 TEST(RegistrationResultJson, NoStageGivesAnEmptyArray) {
@@ -148,6 +153,9 @@ TEST(RegistrationResultJson, WriteThenReadGivesTheSameResult) {
   EXPECT_EQ(s.prealignShift_world_mm, a.stages[0].prealignShift_world_mm);
   EXPECT_EQ(s.rotationSweepSeeds, a.stages[0].rotationSweepSeeds);
   EXPECT_EQ(s.metalPiecesGivenBack, 3);
+  EXPECT_EQ(s.hazeViewsCorrected, 1);
+  EXPECT_EQ(s.hazeFraction, 0.125);
+  EXPECT_EQ(s.hazeViewsKept, a.stages[0].hazeViewsKept);
   EXPECT_FALSE(s.cancelled);
   EXPECT_EQ(b.totalSeconds, 7.5);
   EXPECT_EQ(b.totalDrrs, 4000);

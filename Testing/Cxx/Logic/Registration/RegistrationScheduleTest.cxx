@@ -95,6 +95,23 @@ TEST(RegistrationSchedule, VlncDomainIsReadWrittenAndResetByTheNccOnlyAblation) 
   EXPECT_TRUE(RegistrationSchedule::fromJson(ablated.toJson(), "ablated").ok()) << "an NCC stage has no domain";
 }
 
+TEST(RegistrationSchedule, HazeRemovalIsReadAndWrittenOnlyWhereItIsOn) {
+  const auto parsed = RegistrationSchedule::fromJson(
+      nlohmann::json::parse(R"({"name": "x", "stages": [{"name": "s", "metric": "vlnc", "level": 1,
+          "haze_sigma_mm": 15, "pixels": {"set": "rois"}, "search": {"strategy": "local", "max_evaluations": 10}}]})"),
+      "test.json");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().stages[0].hazeSigma_mm, 15.0);
+  const auto json = parsed.value().toJson();
+  EXPECT_EQ(json["stages"][0]["haze_sigma_mm"], 15.0);
+  const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(again.value().toJson(), json);
+  for (const auto& stage : RegistrationSchedule::builtin("clinical").value().toJson()["stages"]) {
+    EXPECT_FALSE(stage.contains("haze_sigma_mm")) << "off by default, and off is not written";
+  }
+}
+
 TEST(RegistrationSchedule, ReadsAUserFileAndResolvesNames) {
   const auto dir = fct::test::scratchDir();
   const auto path = dir / "mine.json";
@@ -146,6 +163,10 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
        "domain"},
       {stageHead + R"("metric": "ncc", "level": 2, "domain": "intensity", "pixels": {"set": "whole"}, )" + search + "]}",
        "domain"},
+      {stageHead + R"("metric": "vlnc", "level": 1, "haze_sigma_mm": 0.5, "pixels": {"set": "whole"}, )" + search + "]}",
+       "haze_sigma_mm"},
+      {stageHead + R"("metric": "vlnc", "level": 1, "haze_sigma_mm": "15", "pixels": {"set": "whole"}, )" + search + "]}",
+       "haze_sigma_mm"},
       {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"step_deg": 10}, "pixels": {"set": "whole"}, )" +
            search + "]}",
        "max_deg"},
