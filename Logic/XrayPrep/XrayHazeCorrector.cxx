@@ -75,6 +75,10 @@ Result<HazeCorrection> XrayHazeCorrector::correct(const FloatImage& xrayLineInte
   if (pixels.size() < kMinPixels) {
     return fail(fmt::format("haze removal: {} valid pixels; at least {} are needed", pixels.size(), kMinPixels));
   }
+  // The valid pixels' intensities and DRR values (measured from the DRR's smallest), in one pass.
+  std::vector<double> intensity, drr;
+  intensity.reserve(pixels.size());
+  drr.reserve(pixels.size());
   double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
   for (const std::int32_t i : pixels) {
     const double d = drrLineIntegrals.pixels[static_cast<std::size_t>(i)];
@@ -82,17 +86,13 @@ Result<HazeCorrection> XrayHazeCorrector::correct(const FloatImage& xrayLineInte
     if (!std::isfinite(d) || !std::isfinite(p)) return fail("haze removal: the X-ray or the DRR has non-finite pixels");
     dMin = std::min(dMin, d);
     dMax = std::max(dMax, d);
+    intensity.push_back(std::exp(-p));
+    drr.push_back(d);
   }
   if (!(dMax - dMin > 1e-6)) return fail("haze removal: the DRR is constant over the valid pixels (no contrast to fit)");
+  for (double& d : drr) d -= dMin;
 
   // The global fit: the attenuation factor c and gain g0.
-  std::vector<double> intensity, drr;
-  intensity.reserve(pixels.size());
-  drr.reserve(pixels.size());
-  for (const std::int32_t i : pixels) {
-    intensity.push_back(std::exp(-double(xrayLineIntegrals.pixels[static_cast<std::size_t>(i)])));
-    drr.push_back(drrLineIntegrals.pixels[static_cast<std::size_t>(i)] - dMin);
-  }
   GlobalFit best;
   for (int k = 0; k < kGainGrid; ++k) {
     const GlobalFit fit = fitGlobally(intensity, drr, 0.5 + k / double(kGainGrid - 1));
