@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# The bias of the optimum: registration started at the true pose of Table 2's ideal trials (the studies' X-rays:
+# continuous patient, 80 kVp spectrum, scatter haze, noise, PSF, vignetting; no tools), with one or more presets.
+# Writes each trial once as a case (`fluoroct evaluate --write-trial`, kept in the work folder and reused), registers
+# it from its truth (`fluoroct register --init truth_pose.json --cut-face-margin-mm 5` with the trial's seed, as the
+# study does) and prints, per preset and CT, the mean and largest final error (mean bone-surface distance to the
+# truth) and how many trials end more than 0.1 mm off; one line per registration goes to WORK/start-at-truth.csv.
+# Usage: scripts/start-at-truth.sh --preset P [--preset P ...] [--ct pelvis|head ...] [--trials "0 1 2 ..."]
+#                                  [--detector 512x512] [--pixel-mm 0.45] [--jobs 2] [--work DIR]
+# Defaults: both CTs, pelvis trials 0-19 except 5 and 15, head trials 0-7, 512x512 at 0.45 mm, 2 jobs,
+# WORK = /tmp/fluoroct-start-at-truth. Environment: BUILD_DIR (default build), FLUOROCT_DATA_DIR (default
+# ../shared/data beside the source tree).
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD_DIR="${BUILD_DIR:-$ROOT/build}"
+DATA="${FLUOROCT_DATA_DIR:-$ROOT/../shared/data}"
+PRESETS=() CTS=() TRIALS="" DETECTOR=512x512 PIXEL_MM=0.45 JOBS=2 WORK=/tmp/fluoroct-start-at-truth
+while (($#)); do
+  case "$1" in
+    --preset) PRESETS+=("$2"); shift ;;
+    --ct) CTS+=("$2"); shift ;;
+    --trials) TRIALS="$2"; shift ;;
+    --detector) DETECTOR="$2"; shift ;;
+    --pixel-mm) PIXEL_MM="$2"; shift ;;
+    --jobs) JOBS="$2"; shift ;;
+    --work) WORK="$2"; shift ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    *) echo "error: unknown option $1 (see --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+((${#PRESETS[@]})) || { echo "error: give at least one --preset (a built-in name or a preset file)" >&2; exit 2; }
+((${#CTS[@]})) || CTS=(pelvis head)
+for ct in "${CTS[@]}"; do
+  [[ "$ct" == pelvis || "$ct" == head ]] || { echo "error: --ct must be pelvis or head, got '$ct'" >&2; exit 2; }
+done
+[[ -d "$DATA/ct" ]] || { echo "error: no CT folder at $DATA/ct; set FLUOROCT_DATA_DIR" >&2; exit 2; }
+for i in "${!PRESETS[@]}"; do  # preset files as absolute paths: the registrations run from the work folder's cases
+  [[ -f "${PRESETS[$i]}" ]] && PRESETS[$i]="$(cd "$(dirname "${PRESETS[$i]}")" && pwd)/$(basename "${PRESETS[$i]}")"
+done
+
+if [[ ! -f "$BUILD_DIR/CMakeCache.txt" ]]; then
+  cmake -S "$ROOT" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+fi
+cmake --build "$BUILD_DIR" -j"${FCT_JOBS:-2}" --target fluoroct > /dev/null
+export FCT="$BUILD_DIR/bin/fluoroct" DATA DETECTOR PIXEL_MM WORK
+mkdir -p "$WORK"
+echo "start at the truth: $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores, commit" \
+  "$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown), $DETECTOR at $PIXEL_MM mm, work folder $WORK"
+
+# ct_path CT / ct_study CT: the CT file and the name the study gives it.
+ct_path() { [[ "$1" == pelvis ]] && echo "$DATA/ct/pelvis_totalseg.nii.gz" || echo "$DATA/ct/head_phantom_philips_bone"; }
+ct_study() { [[ "$1" == pelvis ]] && echo pelvis_totalseg || echo head_phantom_philips_bone; }
+export -f ct_path ct_study
+
+# write_case CT TRIAL: the trial's case folder (written once), printed with the trial's seed.
+write_case() {
+  local ct="$1" trial="$2" dir="$WORK/$DETECTOR/$1-ideal-$2"
+  if [[ ! -f "$dir/truth_pose.json" ]]; then
+    "$FCT" evaluate --study table2 --detector "$DETECTOR" --pixel-mm "$PIXEL_MM" --ct "$(ct_path "$ct")" \
+      --write-trial "$(ct_study "$ct")/ideal:$trial" --out "$dir" > "$dir.log" 2>&1 ||
+      { echo "error: writing $ct trial $trial failed; see $dir.log" >&2; return 1; }
+  fi
+  grep -o -- '--seed [0-9]*' "$dir.log" | head -1 | awk '{print $2}' > "$dir.seed"
+}
+# register_case PRESET CT TRIAL: one registration from the truth; prints a CSV line.
+register_case() {
+  local preset="$1" ct="$2" trial="$3" dir="$WORK/$DETECTOR/$2-ideal-$3"
+  local out="$dir.$(basename "$preset" .json)"
+  "$FCT" register --ct "$(ct_path "$ct")" --views "$dir/views.json" --init "$dir/truth_pose.json" \
+    --truth "$dir/truth_pose.json" --preset "$preset" --cut-face-margin-mm 5 --seed "$(cat "$dir.seed")" \
+    --out "$out.json" > "$out.log" 2>&1 || { echo "error: registering $ct trial $trial failed; see $out.log" >&2; return 1; }
+  local error_mm
+  error_mm="$(grep 'pose error vs truth' "$out.log" | sed -E 's/.*-> ([0-9.]+) mm.*/\1/')"
+  echo "$(basename "$preset" .json),$ct,$trial,$error_mm"
+}
+export -f write_case register_case
+
+tasks=()
+for ct in "${CTS[@]}"; do
+  trials="$TRIALS"
+  [[ -n "$trials" ]] || { [[ "$ct" == pelvis ]] && trials="$(seq 0 19 | grep -vxE '5|15' | xargs)" || trials="$(seq 0 7 | xargs)"; }
+  for t in $trials; do tasks+=("$ct $t"); done
+done
+mkdir -p "$WORK/$DETECTOR"
+printf '%s\n' "${tasks[@]}" | xargs -P "$JOBS" -L 1 bash -c 'write_case "$0" "$1"'
+CSV="$WORK/start-at-truth.csv"
+echo "preset,ct,trial,final_error_mm" > "$CSV"
+for preset in "${PRESETS[@]}"; do
+  printf '%s\n' "${tasks[@]}" | xargs -P "$JOBS" -L 1 bash -c 'register_case "$1" "$2" "$3"' _ "$preset" >> "$CSV"
+done
+echo "preset,ct,trials,mean_mm,max_mm,above_0.1_mm"
+tail -n +2 "$CSV" | sort -t, -k1,2 | awk -F, '
+  { key = $1 "," $2; n[key]++; s[key] += $4; if ($4 > m[key]) m[key] = $4; if ($4 > 0.1) k[key]++ }
+  END { for (key in n) printf "%s,%d,%.3f,%.3f,%d\n", key, n[key], s[key] / n[key], m[key], k[key] }' | sort
+echo "per registration: $CSV"
