@@ -7,7 +7,7 @@
 # truth) and how many trials end more than 0.1 mm off; one line per registration goes to WORK/start-at-truth.csv.
 # Usage: scripts/start-at-truth.sh --preset P [--preset P ...] [--ct pelvis|head ...] [--trials "0 1 2 ..."]
 #                                  [--detector 512x512] [--pixel-mm 0.45] [--jobs 2] [--work DIR]
-# Defaults: both CTs, pelvis trials 0-19 except 5 and 15, head trials 0-7, 512x512 at 0.45 mm, 2 jobs,
+# Defaults: both CTs, pelvis trials 0-19, head trials 0-7, 512x512 at 0.45 mm, 2 jobs,
 # WORK = /tmp/fluoroct-start-at-truth. Environment: BUILD_DIR (default build), FLUOROCT_DATA_DIR (default
 # ../shared/data beside the source tree).
 set -euo pipefail
@@ -79,7 +79,7 @@ export -f write_case register_case
 tasks=()
 for ct in "${CTS[@]}"; do
   trials="$TRIALS"
-  [[ -n "$trials" ]] || { [[ "$ct" == pelvis ]] && trials="$(seq 0 19 | grep -vxE '5|15' | xargs)" || trials="$(seq 0 7 | xargs)"; }
+  [[ -n "$trials" ]] || { [[ "$ct" == pelvis ]] && trials="$(seq 0 19 | xargs)" || trials="$(seq 0 7 | xargs)"; }
   for t in $trials; do tasks+=("$ct $t"); done
 done
 mkdir -p "$WORK/$DETECTOR"
