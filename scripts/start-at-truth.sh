@@ -61,7 +61,10 @@ write_case() {
       --write-trial "$(ct_study "$ct")/ideal:$trial" --out "$dir" > "$dir.log" 2>&1 ||
       { echo "error: writing $ct trial $trial failed; see $dir.log" >&2; return 1; }
   fi
-  grep -o -- '--seed [0-9]*' "$dir.log" | head -1 | awk '{print $2}' > "$dir.seed"
+  local seed
+  seed="$(grep -o -- '--seed [0-9]*' "$dir.log" 2>/dev/null | head -1 | awk '{print $2}')"
+  [[ -n "$seed" ]] || { echo "error: no trial seed in $dir.log; delete $dir to write the case again" >&2; return 1; }
+  echo "$seed" > "$dir.seed"
 }
 # register_case PRESET CT TRIAL: one registration from the truth; prints a CSV line.
 register_case() {
@@ -72,6 +75,7 @@ register_case() {
     --out "$out.json" > "$out.log" 2>&1 || { echo "error: registering $ct trial $trial failed; see $out.log" >&2; return 1; }
   local error_mm
   error_mm="$(grep 'pose error vs truth' "$out.log" | sed -E 's/.*-> ([0-9.]+) mm.*/\1/')"
+  [[ -n "$error_mm" ]] || { echo "error: no pose error in $out.log (registering $ct trial $trial)" >&2; return 1; }
   echo "$(basename "$preset" .json),$ct,$trial,$error_mm"
 }
 export -f write_case register_case
@@ -83,7 +87,7 @@ for ct in "${CTS[@]}"; do
   for t in $trials; do tasks+=("$ct $t"); done
 done
 mkdir -p "$WORK/$DETECTOR"
-printf '%s\n' "${tasks[@]}" | xargs -P "$JOBS" -L 1 bash -c 'write_case "$0" "$1"'
+printf '%s\n' "${tasks[@]}" | xargs -P "$JOBS" -L 1 bash -c 'write_case "$1" "$2"' _
 CSV="$WORK/start-at-truth.csv"
 echo "preset,ct,trial,final_error_mm" > "$CSV"
 for preset in "${PRESETS[@]}"; do
