@@ -160,6 +160,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                   {"roi_fraction", run.tracker.roiFraction},
                                   {"max_evaluations", run.tracker.maxEvaluations},
                                   {"refine_evaluations", run.tracker.refineEvaluations},
+                                  {"depth_velocity", run.tracker.depthVelocityFactor},
                                   {"dissimilarity_growth", run.tracker.dissimilarityGrowth},
                                   {"max_jump_mm", run.tracker.maxJump_mm},
                                   {"max_jump_deg", run.tracker.maxJump_deg}}}};
@@ -338,6 +339,10 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--refine-evaluations", options->tracker.refineEvaluations,
                       "After the per-frame search, an exact-DRR refinement with this cap on DRR sets (0 = none; for "
                       "--method transgraph)")
+      ->capture_default_str();
+  command->add_option("--depth-velocity", options->tracker.depthVelocityFactor,
+                      "Single-plane: fraction of the last frame-to-frame motion along the viewing ray carried into the "
+                      "next frame's start (0 keeps the depth, 1 = full constant velocity)")
       ->capture_default_str();
   command->add_option("--dissimilarity-growth", options->tracker.dissimilarityGrowth,
                       "Lost track: 1 - similarity above this times the reference (the smaller of the running level's "

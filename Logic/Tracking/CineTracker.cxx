@@ -42,6 +42,9 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   if (!(o.dissimilarityGrowth > 1.0 && std::isfinite(o.dissimilarityGrowth))) {
     return fail(fmt::format("lost-track dissimilarity growth must be above 1, got {}", o.dissimilarityGrowth));
   }
+  if (!(o.depthVelocityFactor >= 0.0 && o.depthVelocityFactor <= 1.0)) {
+    return fail(fmt::format("single-plane depth velocity factor must be in [0, 1], got {}", o.depthVelocityFactor));
+  }
   if (!(o.levelWeight > 0.0 && o.levelWeight <= 1.0)) {
     return fail(fmt::format("running-level weight must be in (0, 1], got {}", o.levelWeight));
   }
@@ -97,18 +100,6 @@ RegistrationSchedule frameScheduleOf(const CineTrackerOptions& o) {
   return schedule;
 }
 
-/// The pose predicted for the next frame: `previous` moved on by the motion from `beforePrevious` to it, in pose
-/// parameters about `centre_ct_mm`; `previous` itself without a second pose.
-Eigen::Isometry3d predictedPose(const Eigen::Isometry3d& previous, const std::optional<Eigen::Isometry3d>& beforePrevious,
-                                const Eigen::Vector3d& centre_ct_mm) {
-  if (!beforePrevious) return previous;
-  auto p1 = RigidPose::fromTransform(previous, centre_ct_mm);
-  auto p0 = RigidPose::fromTransform(*beforePrevious, centre_ct_mm);
-  if (!p1 || !p0) return previous;
-  const PoseVector next = 2.0 * p1.value().asVector() - p0.value().asVector();
-  return RigidPose::toTransform(PoseParameters::fromVector(next), centre_ct_mm);
-}
-
 }  // namespace
 
 const char* CineTracker::statusName(TrackedFrameStatus status) {
@@ -158,6 +149,23 @@ Status CineTracker::runSchedule(const RegistrationSchedule& schedule, const Eige
   if (!r.stages.empty()) frame.similarity = r.stages.back().similarity;
   frame.cancelled = frame.cancelled || r.cancelled;
   return Ok{};
+}
+
+Eigen::Isometry3d CineTracker::predictedPose() const {
+  if (!m_options.constantVelocity || !m_T_beforePrevious) return *m_T_previous;
+  const Eigen::Vector3d& centre_ct_mm = m_case->rotationCentre_ct_mm();
+  auto p1 = RigidPose::fromTransform(*m_T_previous, centre_ct_mm);
+  auto p0 = RigidPose::fromTransform(*m_T_beforePrevious, centre_ct_mm);
+  if (!p1 || !p0) return *m_T_previous;
+  const PoseVector next = 2.0 * p1.value().asVector() - p0.value().asVector();
+  Eigen::Isometry3d T_predicted = RigidPose::toTransform(PoseParameters::fromVector(next), centre_ct_mm);
+  if (m_case->viewCount() == 1) {
+    const Eigen::Vector3d centre_world_mm = *m_T_previous * centre_ct_mm;
+    const Eigen::Vector3d ray_world = (centre_world_mm - m_case->camera(0).sourcePosition_world_mm()).normalized();
+    const double alongRay_mm = (T_predicted * centre_ct_mm - centre_world_mm).dot(ray_world);
+    T_predicted.pretranslate(-(1.0 - m_options.depthVelocityFactor) * alongRay_mm * ray_world);
+  }
+  return T_predicted;
 }
 
 bool CineTracker::withinBounds(const TrackedFrame& frame) const {
@@ -218,9 +226,7 @@ Result<TrackedFrame> CineTracker::trackNext(const std::vector<XrayImage>& frameI
   TrackedFrame frame;
   frame.index = m_nextIndex;
   frame.runningLevel = m_level.running();
-  const Eigen::Vector3d& centre = m_case->rotationCentre_ct_mm();
-  frame.T_predicted_world_from_ct = frame.T_world_from_ct =
-      m_options.constantVelocity ? predictedPose(*m_T_previous, m_T_beforePrevious, centre) : *m_T_previous;
+  frame.T_predicted_world_from_ct = frame.T_world_from_ct = predictedPose();
   Status usable = Ok{};
   for (std::size_t v = 0; v < frameImages.size() && usable; ++v) usable = m_case->replaceXray(v, frameImages[v]);
   frame.swapSeconds = secondsSince(start);

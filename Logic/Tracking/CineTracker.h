@@ -2,8 +2,8 @@
 // CineTracker: follows the bone through a fluoroscopy sequence frame by frame on one RegistrationCase (CT, renderers,
 // Transgraph tables and bone surface prepared once, on frame 0's images). Frame 0 is registered with a full schedule
 // (the default preset). Every later frame swaps each view's X-ray for the new frame (RegistrationCase::replaceXray),
-// starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre)
-// and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
+// starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre;
+// with one view only a fraction of the motion along the viewing ray, which that view barely observes) and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
 // run by Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose
 // dissimilarity (1 - similarity) grows beyond dissimilarityGrowth times the reference (the smaller of the running level's
 // and frame 0's, so that a slow fall cannot drag the reference down with it; SimilarityLevel), or whose pose differs
@@ -75,6 +75,11 @@ struct CineTrackerOptions {
   /// DRR sets (for Transgraph tables, whose interpolation is too coarse for the final pose); 0: none.
   int refineEvaluations = 0;
   bool constantVelocity = true;   ///< predict previous pose + last inter-frame motion (false: previous pose)
+  /// With one view: the fraction of the last inter-frame motion of the rotation centre along the viewing ray (source
+  /// to centre) that the prediction carries on, in [0, 1] (0 keeps the depth, 1 is the full constant velocity). One
+  /// view sees that motion only through the magnification, so the search corrects little of it and a full velocity
+  /// overshoots where the bone turns (docs/tracking.md). Ignored with two or more views.
+  double depthVelocityFactor = 0.5;
   /// Suspect when 1 - similarity > this x the reference dissimilarity: the smaller of 1 - running level and
   /// 1 - frame 0's similarity, at least SimilarityLevel::kMinReferenceDissimilarity; > 1.
   double dissimilarityGrowth = 1.75;
@@ -118,6 +123,10 @@ class CineTracker {
   /// Registration's message.
   Status runSchedule(const RegistrationSchedule& schedule, const Eigen::Isometry3d& T_start,
                      const std::atomic<bool>* cancel, TrackedFrame& frame);
+  /// The start of the next frame's search: the last trusted pose moved on by the last inter-frame motion (pose
+  /// parameters about the rotation centre; with one view only depthVelocityFactor of its part along the viewing ray),
+  /// or the last trusted pose itself without a second pose or with constantVelocity off.
+  Eigen::Isometry3d predictedPose() const;
   /// True when `frame` passes the lost-track rule against the running level and its prediction.
   bool withinBounds(const TrackedFrame& frame) const;
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "Registration/RegistrationCase.h"
@@ -189,4 +190,44 @@ TEST(CineTracker, ExactRefinementFollowsTheFrameStage) {
   }
   options.refineEvaluations = -1;
   EXPECT_FALSE(fct::CineTracker::create(t.registrationCase, options).ok());
+}
+
+TEST(CineTracker, SinglePlanePredictionCarriesOnlyPartOfTheMotionAlongTheViewingRay) {
+  for (const int viewCount : {1, 2}) {
+    Tracked t = prepare(4, viewCount);
+    fct::CineTrackerOptions options = fastTracker();
+    options.depthVelocityFactor = 0.25;
+    auto tracker = fct::CineTracker::create(t.registrationCase, options);
+    ASSERT_TRUE(tracker.ok()) << tracker.error();
+    auto first = tracker.value().trackFirst(firstStart(t));
+    ASSERT_TRUE(first.ok()) << first.error();
+    const Eigen::Vector3d& c_ct_mm = t.registrationCase.rotationCentre_ct_mm();
+    const Eigen::Vector3d source_world_mm = t.registrationCase.camera(0).sourcePosition_world_mm();
+    std::vector<Eigen::Isometry3d> tracked = {first.value().T_world_from_ct};
+    for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
+      auto frame = tracker.value().trackNext(t.sequence.frames[f]);
+      ASSERT_TRUE(frame.ok()) << frame.error();
+      ASSERT_EQ(frame.value().status, fct::TrackedFrameStatus::Tracked) << "frame " << f;
+      if (f >= 2) {
+        const Eigen::Vector3d c1 = tracked[f - 1] * c_ct_mm, c0 = tracked[f - 2] * c_ct_mm;
+        const Eigen::Vector3d ray = (c1 - source_world_mm).normalized();
+        const Eigen::Vector3d lastMove = c1 - c0;
+        const Eigen::Vector3d predictedMove = frame.value().T_predicted_world_from_ct * c_ct_mm - c1;
+        const double alongFactor = viewCount == 1 ? 0.25 : 1.0;  // biplane sees the depth: full velocity
+        EXPECT_NEAR(predictedMove.dot(ray), alongFactor * lastMove.dot(ray), 1e-6) << viewCount << " views, frame " << f;
+        EXPECT_LT((predictedMove - predictedMove.dot(ray) * ray - (lastMove - lastMove.dot(ray) * ray)).norm(), 1e-6)
+            << viewCount << " views, frame " << f;
+        EXPECT_GT(std::abs(lastMove.dot(ray)), 0.01) << "the sequence should move along the ray for this test";
+      }
+      tracked.push_back(frame.value().T_world_from_ct);
+    }
+  }
+  Tracked t = prepare(1, 1);
+  fct::CineTrackerOptions options = fastTracker();
+  for (const double bad : {-0.1, 1.5, std::nan("")}) {
+    options.depthVelocityFactor = bad;
+    auto rejected = fct::CineTracker::create(t.registrationCase, options);
+    ASSERT_FALSE(rejected.ok()) << bad;
+    EXPECT_NE(rejected.error().find("depth velocity"), std::string::npos) << rejected.error();
+  }
 }
