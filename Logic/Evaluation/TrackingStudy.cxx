@@ -253,11 +253,12 @@ std::vector<std::string> TrackingStudy::notes(const TrackingStudyDefinition& stu
       m.jerkTranslation_mm, m.jerkRotation_deg, m.jerkFrames, m.jerkFrame, study.sourceToDetector_mm,
       study.sourceToIsocentre_mm));
   out.push_back(fmt::format("frame 0: registered with the '{}' preset from a random pose at {:g} mm mean sTRE from its "
-                            "truth; later frames: CineTracker defaults (constant-velocity prediction, local search on "
-                            "VLNC ROIs of {:g} % of the valid pixels at the finest pyramid level at most {} px across, "
-                            "recovery when lost); registration on the original CT, Siddon DRRs",
-                            study.preset, study.initialStre_mm, 100.0 * CineTrackerOptions{}.roiFraction,
-                            CineTracker::kAutomaticLevelSide_px));
+                            "truth; later frames: CineTracker defaults (constant-velocity prediction, single-plane "
+                            "with {:g} of the motion along the viewing ray; local search on VLNC ROIs of {:g} % of the "
+                            "valid pixels at the finest pyramid level at most {} px across; recovery when lost); "
+                            "registration on the original CT, Siddon DRRs",
+                            study.preset, study.initialStre_mm, CineTrackerOptions{}.depthVelocityFactor,
+                            100.0 * CineTrackerOptions{}.roiFraction, CineTracker::kAutomaticLevelSide_px));
   if (auto schedule = RegistrationSchedule::resolve(study.preset)) {
     for (const std::string& note : schedule.value().stageDrrNotes()) out.push_back("frame 0: the preset's " + note);
   }
