@@ -254,10 +254,6 @@ int runTrack(const Options& o) {
   auto inputs = readInputs(o);
   if (!inputs) return reportError(inputs.error());
   const Inputs& in = inputs.value();
-  std::error_code ec;
-  fs::create_directories(o.out, ec);
-  if (ec) return reportError(fmt::format("--out: cannot create the folder '{}': {}", o.out, ec.message()));
-
   const InterruptGuard interrupt;  // Ctrl-C ends the run after the current frame, with the frames so far written
   const std::atomic<bool>* cancel = InterruptGuard::cancelFlag();
   auto registrationCase = RegistrationCase::create(in.ct, in.views,
@@ -270,6 +266,9 @@ int runTrack(const Options& o) {
   trackerOptions.firstFrame.seed = o.seed;
   auto tracker = CineTracker::create(registrationCase.value(), trackerOptions);
   if (!tracker) return reportError(tracker.error());
+  std::error_code ec;  // made once the inputs and options are known to be good, so a bad run leaves no folder
+  fs::create_directories(o.out, ec);
+  if (ec) return reportError(fmt::format("--out: cannot create the folder '{}': {}", o.out, ec.message()));
 
   TrackRun run;
   run.centre_ct_mm = registrationCase.value().rotationCentre_ct_mm();

@@ -84,4 +84,9 @@ TEST(TrackCommand, BadInputsGiveOneClearErrorLine) {
                           " --igtl nohost");
   EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
   EXPECT_NE(run.err.find("--igtl"), std::string::npos) << run.err;
+  run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
+                          " --depth-velocity 2");
+  EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
+  EXPECT_NE(run.err.find("depth velocity"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(dir / "out")) << "a run that stops on bad input leaves no output folder";
 }
