@@ -3,8 +3,9 @@
 // Transgraph tables and bone surface prepared once, on frame 0's images). Frame 0 is registered with a full schedule
 // (the default preset). Every later frame swaps each view's X-ray for the new frame (RegistrationCase::replaceXray),
 // starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre;
-// with one view only a fraction of the motion along the viewing ray, which that view barely observes) and runs one short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage",
-// run by Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose
+// with one view only a fraction of the motion along the viewing ray, which that view barely observes) and runs one
+// short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage", run by
+// Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose
 // dissimilarity (1 - similarity) grows beyond dissimilarityGrowth times the reference (the smaller of the running level's
 // and frame 0's, so that a slow fall cannot drag the reference down with it; SimilarityLevel), or whose pose differs
 // from the prediction by more than the jump limits, is re-registered from the prediction with the global stage(s) of
@@ -94,7 +95,7 @@ class CineTracker {
   /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
   /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
   /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside
-  /// (0, 1], a non-positive jump limit, or an unknown first-frame preset.
+  /// (0, 1], a non-positive jump limit, a depth velocity factor outside [0, 1], or an unknown first-frame preset.
   static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
 
   /// Registers frame 0 (the case's current images) with the first-frame schedule from T_initial and sets the running
