@@ -39,10 +39,8 @@ for i in "${!PRESETS[@]}"; do  # preset files as absolute paths: the registratio
   [[ -f "${PRESETS[$i]}" ]] && PRESETS[$i]="$(cd "$(dirname "${PRESETS[$i]}")" && pwd)/$(basename "${PRESETS[$i]}")"
 done
 
-if [[ ! -f "$BUILD_DIR/CMakeCache.txt" ]]; then
-  cmake -S "$ROOT" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
-fi
-cmake --build "$BUILD_DIR" -j"${FCT_JOBS:-2}" --target fluoroct > /dev/null
+FCT_BUILD_DIR="$BUILD_DIR" FCT_BUILD_TARGETS=(fluoroct)
+source "$ROOT/scripts/setup.sh" > /dev/null  # the project's packages and build (fct_build), only `fluoroct`
 export FCT="$BUILD_DIR/bin/fluoroct" DATA DETECTOR PIXEL_MM WORK
 mkdir -p "$WORK"
 echo "start at the truth: $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores, commit" \
@@ -53,7 +51,14 @@ ct_path() { [[ "$1" == pelvis ]] && echo "$DATA/ct/pelvis_totalseg.nii.gz" || ec
 ct_study() { [[ "$1" == pelvis ]] && echo pelvis_totalseg || echo head_phantom_philips_bone; }
 export -f ct_path ct_study
 
-# write_case CT TRIAL: the trial's case folder (written once), printed with the trial's seed.
+# trial_seed DIR: the trial's seed, from the register command that --write-trial printed into DIR.log.
+trial_seed() {
+  local seed
+  seed="$(grep -o -- '--seed [0-9]*' "$1.log" 2>/dev/null | head -1 | awk '{print $2}')"
+  [[ -n "$seed" ]] || { echo "error: no trial seed in $1.log; delete $1 to write the case again" >&2; return 1; }
+  echo "$seed"
+}
+# write_case CT TRIAL: the trial's case folder, written once; fails when its seed cannot be read back.
 write_case() {
   local ct="$1" trial="$2" dir="$WORK/$DETECTOR/$1-ideal-$2"
   if [[ ! -f "$dir/truth_pose.json" ]]; then
@@ -61,24 +66,22 @@ write_case() {
       --write-trial "$(ct_study "$ct")/ideal:$trial" --out "$dir" > "$dir.log" 2>&1 ||
       { echo "error: writing $ct trial $trial failed; see $dir.log" >&2; return 1; }
   fi
-  local seed
-  seed="$(grep -o -- '--seed [0-9]*' "$dir.log" 2>/dev/null | head -1 | awk '{print $2}')"
-  [[ -n "$seed" ]] || { echo "error: no trial seed in $dir.log; delete $dir to write the case again" >&2; return 1; }
-  echo "$seed" > "$dir.seed"
+  trial_seed "$dir" > /dev/null
 }
 # register_case PRESET CT TRIAL: one registration from the truth; prints a CSV line.
 register_case() {
   local preset="$1" ct="$2" trial="$3" dir="$WORK/$DETECTOR/$2-ideal-$3"
-  local out="$dir.$(basename "$preset" .json)"
+  local out="$dir.$(basename "$preset" .json)" seed
+  seed="$(trial_seed "$dir")" || return 1
   "$FCT" register --ct "$(ct_path "$ct")" --views "$dir/views.json" --init "$dir/truth_pose.json" \
-    --truth "$dir/truth_pose.json" --preset "$preset" --cut-face-margin-mm 5 --seed "$(cat "$dir.seed")" \
+    --truth "$dir/truth_pose.json" --preset "$preset" --cut-face-margin-mm 5 --seed "$seed" \
     --out "$out.json" > "$out.log" 2>&1 || { echo "error: registering $ct trial $trial failed; see $out.log" >&2; return 1; }
   local error_mm
   error_mm="$(grep 'pose error vs truth' "$out.log" | sed -E 's/.*-> ([0-9.]+) mm.*/\1/')"
   [[ -n "$error_mm" ]] || { echo "error: no pose error in $out.log (registering $ct trial $trial)" >&2; return 1; }
   echo "$(basename "$preset" .json),$ct,$trial,$error_mm"
 }
-export -f write_case register_case
+export -f trial_seed write_case register_case
 
 tasks=()
 for ct in "${CTS[@]}"; do

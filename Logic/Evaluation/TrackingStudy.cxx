@@ -252,13 +252,14 @@ std::vector<std::string> TrackingStudy::notes(const TrackingStudyDefinition& stu
       m.frames, m.sinusoids, m.minPeriod_frames, m.maxPeriod_frames, m.maxTranslation_mm, m.maxRotation_deg,
       m.jerkTranslation_mm, m.jerkRotation_deg, m.jerkFrames, m.jerkFrame, study.sourceToDetector_mm,
       study.sourceToIsocentre_mm));
+  const CineTrackerOptions trackerDefaults;
   out.push_back(fmt::format("frame 0: registered with the '{}' preset from a random pose at {:g} mm mean sTRE from its "
                             "truth; later frames: CineTracker defaults (constant-velocity prediction, single-plane "
                             "with {:g} of the motion along the viewing ray; local search on VLNC ROIs of {:g} % of the "
                             "valid pixels at the finest pyramid level at most {} px across; recovery when lost); "
                             "registration on the original CT, Siddon DRRs",
-                            study.preset, study.initialStre_mm, CineTrackerOptions{}.depthVelocityFactor,
-                            100.0 * CineTrackerOptions{}.roiFraction, CineTracker::kAutomaticLevelSide_px));
+                            study.preset, study.initialStre_mm, trackerDefaults.depthVelocityFactor,
+                            100.0 * trackerDefaults.roiFraction, CineTracker::kAutomaticLevelSide_px));
   if (auto schedule = RegistrationSchedule::resolve(study.preset)) {
     for (const std::string& note : schedule.value().stageDrrNotes()) out.push_back("frame 0: the preset's " + note);
   }
