@@ -40,6 +40,7 @@ struct Options {
   std::string preset = RegistrationSchedule::kDefaultPreset;
   std::uint32_t seed = 1;
   std::string method = "siddon";
+  std::string frameDrr = "auto";
   std::string transgraphCache;  ///< empty = the default cache folder; "none" = no cache
   CineTrackerOptions tracker;
   bool noFieldOfView = false;
@@ -160,7 +161,9 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                   {"roi_fraction", run.tracker.roiFraction},
                                   {"max_evaluations", run.tracker.maxEvaluations},
                                   {"refine_evaluations", run.tracker.refineEvaluations},
+                                  {"frame_drr", DrrRendererFactory::methodName(*run.tracker.frameDrr)},
                                   {"depth_velocity", run.tracker.depthVelocityFactor},
+                                  {"depth_scale", run.tracker.depthScale},
                                   {"dissimilarity_growth", run.tracker.dissimilarityGrowth},
                                   {"max_jump_mm", run.tracker.maxJump_mm},
                                   {"max_jump_deg", run.tracker.maxJump_deg}}}};
@@ -249,6 +252,11 @@ int runTrack(const Options& o) {
   if (!sender) return reportError(sender.error());
   auto method = DrrRendererFactory::parseMethod(o.method);
   if (!method) return reportError("--method: " + method.error());
+  auto frameDrr = DrrRendererFactory::parseMethod(o.frameDrr);
+  if (o.frameDrr != "auto" && (!frameDrr || frameDrr.value() == DrrMethod::Transgraph)) {
+    return reportError(fmt::format("--frame-drr: '{}' is not a frame DRR method; use auto, raycast or siddon",
+                                   o.frameDrr));
+  }
   auto schedule = RegistrationSchedule::resolve(o.preset);
   if (!schedule) return reportError("--preset: " + schedule.error());
   auto inputs = readInputs(o);
@@ -262,6 +270,7 @@ int runTrack(const Options& o) {
   if (!registrationCase) return reportError(registrationCase.error());
   printWarnings(registrationCase.warnings());
   CineTrackerOptions trackerOptions = o.tracker;
+  if (frameDrr) trackerOptions.frameDrr = frameDrr.value();
   trackerOptions.firstFrame.schedule = std::move(schedule).value();
   trackerOptions.firstFrame.seed = o.seed;
   auto tracker = CineTracker::create(registrationCase.value(), trackerOptions);
@@ -320,8 +329,8 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the random searches")->capture_default_str();
   command->add_option("--method", options->method,
-                      "DRR method: siddon (exact, on the CT coarsened to the tracking level) or transgraph (one ray "
-                      "table per view built once around frame 0's initial pose)")
+                      "DRR method of frame 0 and, for transgraph, of the per-frame search: siddon (exact) or "
+                      "transgraph (one ray table per view built once around frame 0's initial pose)")
       ->capture_default_str();
   command->add_option("--transgraph-cache", options->transgraphCache,
                       "Folder of the transgraph table cache (default: ~/.cache/fluoroct/transgraph); 'none' disables it");
@@ -338,6 +347,16 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
   command->add_option("--refine-evaluations", options->tracker.refineEvaluations,
                       "After the per-frame search, an exact-DRR refinement with this cap on DRR sets (0 = none; for "
                       "--method transgraph)")
+      ->capture_default_str();
+  command->add_option("--frame-drr", options->frameDrr,
+                      "How the per-frame search renders without Transgraph tables, on the CT coarsened to the "
+                      "tracking level: auto (raycast with one view, siddon with two or more), raycast (trilinear: a "
+                      "smooth similarity, which a single-plane search needs to find the depth) or siddon (exact box "
+                      "voxels, faster)")
+      ->capture_default_str();
+  command->add_option("--depth-scale", options->tracker.depthScale,
+                      "Single-plane: the per-frame search's step along the viewing ray, in steps across it (1 to "
+                      "100; one view sees depth only through the magnification)")
       ->capture_default_str();
   command->add_option("--depth-velocity", options->tracker.depthVelocityFactor,
                       "Single-plane: fraction of the last frame-to-frame motion along the viewing ray carried into the "

@@ -317,6 +317,50 @@ Status sweepRotations(RegistrationCase& registrationCase, const RegistrationStag
   return Ok{};
 }
 
+/// The coordinates a stage's search moves in: the pose parameters (rotation about the bone centre, world translation)
+/// in the case's scales, or, for a one-view local stage with depthScale > 1, the translation in the frame of the
+/// viewing ray (z from the source through the bone centre at the stage's start, x across it along the detector's
+/// columns, y = z x x) with the scale along z depthScale times the scale across it.
+struct SearchFrame {
+  Eigen::Matrix3d R_world_from_search = Eigen::Matrix3d::Identity();
+  PoseVector scales;
+
+  /// Search coordinates of pose parameters.
+  PoseVector toSearch(const PoseVector& params) const {
+    PoseVector q = params;
+    q.tail<3>() = R_world_from_search.transpose() * params.tail<3>();
+    return q;
+  }
+  /// Pose parameters of search coordinates.
+  PoseVector toPose(const PoseVector& q) const {
+    PoseVector params = q;
+    params.tail<3>() = R_world_from_search * q.tail<3>();
+    return params;
+  }
+};
+
+/// The search frame of `stage` started at `current` (see SearchFrame). The case's translation scales are equal on
+/// the three axes (PoseOptimizer::scalesForBoneRadius), so turning them does not change them.
+SearchFrame searchFrameFor(const RegistrationCase& registrationCase, const RegistrationStage& stage,
+                           const PoseVector& current) {
+  SearchFrame frame;
+  frame.scales = registrationCase.scales();
+  if (stage.depthScale == 1.0 || registrationCase.viewCount() != 1 || stage.search != SearchStrategy::Local) {
+    return frame;
+  }
+  const Camera& camera = registrationCase.camera(0);
+  const Eigen::Vector3d centre_world_mm =
+      registrationCase.poseTransform(current) * registrationCase.rotationCentre_ct_mm();
+  const Eigen::Vector3d z = (centre_world_mm - camera.sourcePosition_world_mm()).normalized();
+  const Eigen::Vector3d columns = camera.T_world_from_camera().linear().col(0);
+  const Eigen::Vector3d x = (columns - columns.dot(z) * z).normalized();
+  frame.R_world_from_search.col(0) = x;
+  frame.R_world_from_search.col(1) = z.cross(x);
+  frame.R_world_from_search.col(2) = z;
+  frame.scales[5] *= stage.depthScale;
+  return frame;
+}
+
 /// Runs stage `stageIndex` from `current` (pose parameters, deg and mm), moving `current` to the stage's best pose;
 /// `drrsBefore` counts the earlier stages' DRRs for the progress reports; `start` is what its pre-alignment and
 /// rotation sweep did. Returns the stage's report; fails, naming the stage, on a rendering or search error.
@@ -337,8 +381,9 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
 
   RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startSimilarity);
   std::string renderError;
-  const PoseObjective f = [&](const PoseVector& params) {
-    auto value = objective.similarity(registrationCase.poseTransform(params));
+  const SearchFrame searchFrame = searchFrameFor(registrationCase, stage, current);
+  const PoseObjective f = [&](const PoseVector& searchParams) {
+    auto value = objective.similarity(registrationCase.poseTransform(searchFrame.toPose(searchParams)));
     if (!value) {
       if (renderError.empty()) renderError = value.error();
       return std::numeric_limits<double>::quiet_NaN();
@@ -354,7 +399,8 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   };
 
   const std::unique_ptr<PoseOptimizer> optimizer = makeOptimizer(stage, start.sweepSeeds);
-  auto found = optimizer->minimize(f, current, registrationCase.scales(), context.monitor);
+  auto found = optimizer->minimize(f, searchFrame.toSearch(current), searchFrame.scales, context.monitor);
+  if (found) found.value().params = searchFrame.toPose(found.value().params);
   if (!renderError.empty()) return fail(fmt::format("stage '{}': {}", stage.name, renderError));
   if (const Status applied = applySearchOutcome(found, context.monitor, report, current); !applied) {
     return fail(fmt::format("stage '{}': {}", stage.name, applied.error()));

@@ -163,6 +163,14 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
     if (s.has("seed")) g.seed = static_cast<std::uint32_t>(s.integer("seed", 0));
     if (const nlohmann::json* simplex = s.find("simplex")) readSimplex(*simplex, searchWhere + ".simplex", s, stage.simplex);
     if (const nlohmann::json* cmaes = s.find("cmaes")) readCmaEs(*cmaes, searchWhere + ".cmaes", s, stage.cmaes);
+    optionalNumber(s, "depth_scale", stage.depthScale);
+    if (s.ok() && s.has("depth_scale")) {
+      if (stage.search != SearchStrategy::Local) {
+        s.rejectKey("depth_scale", "applies only with \"strategy\": \"local\"");
+      } else if (!(stage.depthScale >= 1.0 && stage.depthScale <= 100.0)) {
+        s.rejectKey("depth_scale", fmt::format("is {}; use 1 (off) to 100", stage.depthScale));
+      }
+    }
     reader.adoptError(s);
   } else {
     reader.rejectKey("search", "is missing; give at least {\"strategy\": \"local\", \"max_evaluations\": 500}");
@@ -286,6 +294,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
       search["simplex"]["stall_window"] = s.simplex.stall.window;
       search["simplex"]["stall_improvement"] = s.simplex.stall.relativeImprovement;
     }
+    if (s.depthScale != 1.0) search["depth_scale"] = s.depthScale;
     search["cmaes"] = {{"sigma", s.cmaes.initialSigma},
                        {"tolerance", s.cmaes.tolerance},
                        {"population", s.cmaes.populationSize},

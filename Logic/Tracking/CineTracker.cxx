@@ -8,6 +8,7 @@
 #include <ctime>
 #include <utility>
 
+#include "Drr/DrrRendererFactory.h"
 #include "Geometry/RigidPose.h"
 #include "Registration/RegistrationObjective.h"
 
@@ -45,6 +46,13 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   if (!(o.depthVelocityFactor >= 0.0 && o.depthVelocityFactor <= 1.0)) {
     return fail(fmt::format("single-plane depth velocity factor must be in [0, 1], got {}", o.depthVelocityFactor));
   }
+  if (!(o.depthScale >= 1.0 && o.depthScale <= 100.0)) {
+    return fail(fmt::format("single-plane depth scale must be in [1, 100], got {}", o.depthScale));
+  }
+  if (o.frameDrr != DrrMethod::RayCast && o.frameDrr != DrrMethod::Siddon) {
+    return fail(fmt::format("the frame stage renders exactly with raycast or siddon, not {}",
+                            DrrRendererFactory::methodName(*o.frameDrr)));
+  }
   if (!(o.levelWeight > 0.0 && o.levelWeight <= 1.0)) {
     return fail(fmt::format("running-level weight must be in (0, 1], got {}", o.levelWeight));
   }
@@ -69,14 +77,23 @@ int automaticLevel(const RegistrationCase& registrationCase) {
   return levels - 1;
 }
 
-/// The frame schedule of the options: VLNC on dynamic ROIs at the tracking level with one local BOBYQA search, then
-/// with refineEvaluations > 0 the same with exact DRRs, a smaller step and that cap.
-RegistrationSchedule frameScheduleOf(const CineTrackerOptions& o) {
+/// Makes `stage` render exactly with the options' (resolved) frame DRR method.
+void renderExactly(const CineTrackerOptions& o, RegistrationStage& stage) {
+  stage.exactDrr = true;
+  stage.drrMethod = o.frameDrr;
+  stage.drrStep_voxels = o.frameDrr == DrrMethod::RayCast ? CineTrackerOptions::kFrameRayCastStep_voxels : 0.0;
+}
+
+/// The frame schedule of the options on a case rendered with `caseMethod`: VLNC on dynamic ROIs at the tracking level
+/// with one local BOBYQA search (on the Transgraph tables, or exactly with frameDrr), then with refineEvaluations > 0
+/// the same rendered exactly, with a smaller step and that cap.
+RegistrationSchedule frameScheduleOf(const CineTrackerOptions& o, DrrMethod caseMethod) {
   RegistrationStage stage;
   stage.name = fmt::format("track-vlnc-rois-level{}", o.level);
   stage.metric = SimilarityMetric::Vlnc;
   stage.level = o.level;
-  stage.exactDrr = o.exactDrr;
+  if (o.exactDrr || caseMethod != DrrMethod::Transgraph) renderExactly(o, stage);
+  stage.depthScale = o.depthScale;
   stage.pixels.kind = PixelSetKind::Rois;
   stage.pixels.windowSize = o.windowSize;
   stage.pixels.targetFraction = o.roiFraction;
@@ -92,7 +109,7 @@ RegistrationSchedule frameScheduleOf(const CineTrackerOptions& o) {
   schedule.stages = {stage};
   if (o.refineEvaluations > 0) {
     stage.name += "-exact";
-    stage.exactDrr = true;
+    renderExactly(o, stage);
     stage.maxEvaluations = stage.simplex.maxEvaluations = o.refineEvaluations;
     stage.simplex.initialStep = std::max(2.0 * o.tolerance, 0.5 * o.initialStep);
     schedule.stages.push_back(stage);
@@ -125,13 +142,14 @@ CineTracker::CineTracker(RegistrationCase& registrationCase, CineTrackerOptions 
 Result<CineTracker> CineTracker::create(RegistrationCase& registrationCase, const CineTrackerOptions& options) {
   CineTrackerOptions resolved = options;
   if (resolved.level == CineTrackerOptions::kAutomaticLevel) resolved.level = automaticLevel(registrationCase);
+  if (!resolved.frameDrr) resolved.frameDrr = registrationCase.viewCount() == 1 ? DrrMethod::RayCast : DrrMethod::Siddon;
   if (Status valid = checkOptions(resolved, registrationCase.levelCount()); !valid) return fail(valid.error());
   if (resolved.firstFrame.schedule.stages.empty()) {
     auto schedule = RegistrationSchedule::builtin(RegistrationSchedule::kDefaultPreset);
     if (!schedule) return fail(schedule.error());
     resolved.firstFrame.schedule = std::move(schedule).value();
   }
-  RegistrationSchedule frameSchedule = frameScheduleOf(resolved);
+  RegistrationSchedule frameSchedule = frameScheduleOf(resolved, registrationCase.drrMethod());
   return CineTracker(registrationCase, std::move(resolved), std::move(frameSchedule));
 }
 

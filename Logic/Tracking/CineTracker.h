@@ -5,7 +5,9 @@
 // starts from the previous pose plus a constant-velocity prediction (pose parameters about the case's rotation centre;
 // with one view only a fraction of the motion along the viewing ray, which that view barely observes) and runs one
 // short local search (BOBYQA) on VLNC over dynamic ROIs re-selected on the new frame (the "frame stage", run by
-// Registration with RegistrationObjective; optionally followed by an exact-DRR refinement). A frame whose
+// Registration with RegistrationObjective, on exact DRRs of the CT coarsened to the level, trilinear with one view and
+// box voxels with two, or on the Transgraph tables; with one view the search's unit along the viewing ray is
+// depthScale times longer; optionally followed by an exact-DRR refinement). A frame whose
 // dissimilarity (1 - similarity) grows beyond dissimilarityGrowth times the reference (the smaller of the running level's
 // and frame 0's, so that a slow fall cannot drag the reference down with it; SimilarityLevel), or whose pose differs
 // from the prediction by more than the jump limits, is re-registered from the prediction with the global stage(s) of
@@ -69,9 +71,22 @@ struct CineTrackerOptions {
   int maxEvaluations = 60;        ///< cap on DRR sets of the frame stage
   double initialStep = 0.5;       ///< BOBYQA's first trust radius, scaled units
   double tolerance = 0.05;        ///< BOBYQA's stopping step, scaled units
-  /// Render the frame stage with the case's exact renderer (Siddon on the CT coarsened to the level) even when the
-  /// case has Transgraph tables; false uses the tables (built once around frame 0's initial pose).
+  /// Render the frame stage exactly (frameDrr on the CT coarsened to the level) even when the case has Transgraph
+  /// tables; false uses the tables (built once around frame 0's initial pose).
   bool exactDrr = false;
+  /// How the frame stage renders when it renders exactly (a case without Transgraph tables, exactDrr, or the
+  /// refinement), on the CT coarsened to the level: RayCast (trilinear samples, one every kFrameRayCastStep_voxels
+  /// coarse voxels) or Siddon (exact box voxels); nullopt: RayCast with one view, Siddon with two or more. Box voxels
+  /// make the similarity jump as ray positions cross voxel edges (by up to 0.003 within 0.05 mm in plane on the pelvis
+  /// at 1:16), which stops a single-plane search before it finds the depth; trilinear samples keep it smooth. Two views
+  /// see the depth anyway, and Siddon is 2-4x faster there (docs/tracking.md).
+  std::optional<DrrMethod> frameDrr;
+  /// The trilinear frame DRR's sampling step along each ray, in voxels of the coarsened CT (docs/tracking.md).
+  static constexpr double kFrameRayCastStep_voxels = 2.0;
+  /// With one view: the frame search's scaled unit along the viewing ray in units across it (RegistrationStage::
+  /// depthScale), in [1, 100]. The similarity is about 400 times flatter in depth than across the ray. Ignored with
+  /// two or more views.
+  double depthScale = 10.0;
   /// > 0: the frame stage is followed by an exact-DRR BOBYQA refinement at the same level and ROIs with this cap on
   /// DRR sets (for Transgraph tables, whose interpolation is too coarse for the final pose); 0: none.
   int refineEvaluations = 0;
@@ -95,7 +110,8 @@ class CineTracker {
   /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
   /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
   /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside
-  /// (0, 1], a non-positive jump limit, a depth velocity factor outside [0, 1], or an unknown first-frame preset.
+  /// (0, 1], a non-positive jump limit, a depth velocity factor outside [0, 1], a depth scale outside [1, 100], a frame
+  /// DRR method other than raycast or siddon, or an unknown first-frame preset.
   static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
 
   /// Registers frame 0 (the case's current images) with the first-frame schedule from T_initial and sets the running

@@ -1,14 +1,16 @@
 // Tracking benchmark: frames per second and per-frame pose error of CineTracker on a simulated sequence (the bone
-// moving smoothly, every frame rendered by the physical simulator, TrackingTestSequence.h), once with Siddon DRRs
-// (the CT coarsened to the tracking level) and once with per-view Transgraph tables built around frame 0's start pose
-// (table build time reported apart). Frame 0 is registered with the default preset from 3 mm off the truth. The error
+// moving smoothly, every frame rendered by the physical simulator, TrackingTestSequence.h), once with exact DRRs
+// (frame 0 Siddon; the frames --frame-drr, trilinear by default, on the CT coarsened to the tracking level) and once
+// with per-view Transgraph tables built around frame 0's start pose (table build time reported apart). Frame 0 is
+// registered with the default preset from 3 mm off the truth. The error
 // of a frame is the mean bone-surface distance to its true pose; frames/s counts the frames after frame 0 over their
 // tracking time (X-ray swap, search, recovery), and the CPU time per frame is printed beside it.
 //
 // Usage: fluoroct_tracking_benchmark --ct CT [--views 1|2] [--size PIXELS] [--pixel-mm MM] [--frames N]
 //                                    [--amplitude-mm MM] [--amplitude-deg DEG] [--period FRAMES] [--level L]
 //                                    [--roi-fraction F] [--max-evaluations N] [--refine-evaluations N]
-//                                    [--method siddon|transgraph|both]
+//                                    [--method siddon|transgraph|both] [--frame-drr raycast|siddon]
+//                                    [--depth-scale S]
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
@@ -41,7 +43,11 @@ bool runMethod(const fct::Volume& ct, const fct::test::SimulatedSequence& sequen
   if (!registrationCase) return fmt::print(stderr, "error: {}\n", registrationCase.error()), false;
   auto tracker = fct::CineTracker::create(registrationCase.value(), trackerOptions);
   if (!tracker) return fmt::print(stderr, "error: {}\n", tracker.error()), false;
-  const std::string name(fct::DrrRendererFactory::methodName(method));
+  // "siddon/raycast": frame 0 with Siddon DRRs, the frames with the tracker's exact frame DRR method.
+  std::string name(fct::DrrRendererFactory::methodName(method));
+  if (method != fct::DrrMethod::Transgraph) {
+    name += "/" + std::string(fct::DrrRendererFactory::methodName(*tracker.value().options().frameDrr));
+  }
   fmt::print("== {} (table setup {:.2f} s)\n", name, registrationCase.value().viewRendererSetupSeconds());
 
   auto first = tracker.value().trackFirst(start);
@@ -105,7 +111,17 @@ int main(int argc, char** argv) {
   app.add_option("--refine-evaluations", trackerOptions.refineEvaluations, "Exact refinement cap (0 = none)")
       ->capture_default_str();
   app.add_option("--method", method, "siddon, transgraph or both")->capture_default_str();
+  std::string frameDrr = "auto";
+  app.add_option("--frame-drr", frameDrr, "Frames' exact DRRs (method siddon): auto, raycast or siddon")
+      ->capture_default_str();
+  app.add_option("--depth-scale", trackerOptions.depthScale, "Single-plane depth scale of the frame search")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (frameDrr != "auto") {
+    auto frameMethod = fct::DrrRendererFactory::parseMethod(frameDrr);
+    if (!frameMethod) return fmt::print(stderr, "error: --frame-drr: {}\n", frameMethod.error()), 2;
+    trackerOptions.frameDrr = frameMethod.value();
+  }
 
   auto ct = fct::CtLoader::load(ctPath);
   if (!ct) return fmt::print(stderr, "error: {}\n", ct.error()), 2;

@@ -36,6 +36,8 @@ TEST(TrackCommand, TracksATinyBiplaneSequenceAndWritesJsonCsvAndPlot) {
   const auto& frames = json.value().at("frames");
   ASSERT_EQ(frames.size(), 4u);
   EXPECT_EQ(json.value().at("cancelled"), false);
+  EXPECT_EQ(json.value().at("options").at("frame_drr"), "siddon") << "the automatic choice for two views";
+  EXPECT_EQ(json.value().at("options").at("depth_scale"), 10.0);
   EXPECT_GT(json.value().at("frames_per_second").get<double>(), 0.0);
   for (std::size_t f = 0; f < frames.size(); ++f) {
     EXPECT_EQ(frames[f].at("index"), static_cast<int>(f));
@@ -88,5 +90,15 @@ TEST(TrackCommand, BadInputsGiveOneClearErrorLine) {
                           " --depth-velocity 2");
   EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
   EXPECT_NE(run.err.find("depth velocity"), std::string::npos) << run.err;
+  run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
+                          " --depth-scale 0.5");
+  EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
+  EXPECT_NE(run.err.find("depth scale"), std::string::npos) << run.err;
+  for (const char* badDrr : {"transgraph", "box"}) {
+    run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
+                            " --frame-drr " + badDrr);
+    EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
+    EXPECT_NE(run.err.find("--frame-drr"), std::string::npos) << run.err;
+  }
   EXPECT_FALSE(fs::exists(dir / "out")) << "a run that stops on bad input leaves no output folder";
 }

@@ -113,6 +113,23 @@ TEST(RegistrationSchedule, HazeRemovalIsReadAndWrittenOnlyWhereItIsOn) {
   }
 }
 
+TEST(RegistrationSchedule, DepthScaleIsReadAndWrittenOnlyWhereItIsOn) {
+  const auto parsed = RegistrationSchedule::fromJson(
+      nlohmann::json::parse(R"({"name": "x", "stages": [{"name": "s", "metric": "vlnc", "level": 2,
+          "pixels": {"set": "rois"}, "search": {"strategy": "local", "max_evaluations": 10, "depth_scale": 10}}]})"),
+      "test.json");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().stages[0].depthScale, 10.0);
+  const auto json = parsed.value().toJson();
+  EXPECT_EQ(json["stages"][0]["search"]["depth_scale"], 10.0);
+  const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(again.value().toJson(), json);
+  for (const auto& stage : RegistrationSchedule::builtin("clinical").value().toJson()["stages"]) {
+    EXPECT_FALSE(stage["search"].contains("depth_scale")) << "off (1) by default, and off is not written";
+  }
+}
+
 TEST(RegistrationSchedule, ReadsAUserFileAndResolvesNames) {
   const auto dir = fct::test::scratchDir();
   const auto path = dir / "mine.json";
@@ -185,6 +202,12 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
       {stageHead + R"("metric": "ncc", "level": 0, "drr": "raycast", "drr_step_voxels": 0, "pixels": {"set": "whole"}, )" +
            search + "]}",
        "drr_step_voxels"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "local", )" +
+           R"("max_evaluations": 10, "depth_scale": 0.5}}]})",
+       "depth_scale"},
+      {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "genetic", )" +
+           R"("max_evaluations": 10, "depth_scale": 10}}]})",
+       "depth_scale"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}})" + "]}", "search"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "local", )" +
            R"("max_evaluations": 10, "simplex": {"tolerance": -1}}}]})",

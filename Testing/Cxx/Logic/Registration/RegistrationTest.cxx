@@ -411,6 +411,68 @@ TEST(Registration, WithoutTheCtPyramidTheSameStartConvergesAsWell) {
       << "the switch changes the coarse levels' DRRs";
 }
 
+/// The one-view local stage of the depth-scale test: VLNC on ROIs at 1:4 with trilinear DRRs, BOBYQA with a tracking
+/// frame's budget.
+fct::RegistrationOptions oneViewLocalOptions(double depthScale) {
+  fct::RegistrationStage stage;
+  stage.name = "one-view-local";
+  stage.metric = fct::SimilarityMetric::Vlnc;
+  stage.level = 1;
+  stage.pixels.kind = fct::PixelSetKind::Rois;
+  stage.pixels.targetFraction = 0.2;
+  stage.search = fct::SearchStrategy::Local;
+  stage.maxEvaluations = stage.simplex.maxEvaluations = 80;
+  stage.simplex.method = fct::LocalSearchMethod::Bobyqa;
+  stage.simplex.initialStep = 0.5;
+  stage.simplex.tolerance = 0.05;
+  stage.simplex.restarts = 0;
+  stage.depthScale = depthScale;
+  stage.drrMethod = fct::DrrMethod::RayCast;  // a smooth similarity, as the tracker's frames have
+  stage.drrStep_voxels = 1.0;
+  fct::RegistrationOptions options;
+  options.schedule.name = "one-view";
+  options.schedule.stages = {stage};
+  return options;
+}
+
+TEST(Registration, OneViewLocalSearchWithADepthScaleMovesTheDepthThatEqualUnitsLeave) {
+  fct::test::KnownTruthOptions geometry;  // the studies' C-arm: one view sees depth only by a weak magnification
+  geometry.sourceToIsocentre_mm = 1000.0;
+  geometry.sourceToDetector_mm = 1500.0;
+  auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), geometry);
+  ASSERT_TRUE(simulated.ok()) << simulated.error();
+  auto oneView = fct::RegistrationCase::create(simulated.value().ct, {simulated.value().views[0]});
+  ASSERT_TRUE(oneView.ok()) << oneView.error();
+  fct::RegistrationCase& rc = oneView.value();
+  const Eigen::Isometry3d& T_truth = simulated.value().T_truth;
+  const Eigen::Vector3d centre_world_mm = T_truth * rc.rotationCentre_ct_mm();
+  const Eigen::Vector3d ray = (centre_world_mm - rc.camera(0).sourcePosition_world_mm()).normalized();
+  Eigen::Isometry3d start = T_truth;
+  start.pretranslate(6.0 * ray);
+  auto depthError_mm = [&](const Eigen::Isometry3d& T) {
+    return (T * rc.rotationCentre_ct_mm() - centre_world_mm).dot(ray);
+  };
+
+  auto equalUnits = fct::Registration::run(rc, start, oneViewLocalOptions(1.0));
+  auto scaled = fct::Registration::run(rc, start, oneViewLocalOptions(10.0));
+  ASSERT_TRUE(equalUnits.ok()) << equalUnits.error();
+  ASSERT_TRUE(scaled.ok()) << scaled.error();
+  const double equalError = depthError_mm(equalUnits.value().T_world_from_ct);
+  const double scaledError = depthError_mm(scaled.value().T_world_from_ct);
+  std::printf("depth error from 6 mm along the ray: equal units %.2f mm (%d evaluations), depth scale 10 %.2f mm "
+              "(%d)\n", equalError, equalUnits.value().stages[0].evaluations, scaledError,
+              scaled.value().stages[0].evaluations);
+  EXPECT_LT(std::abs(scaledError), 1.0);
+  EXPECT_GT(std::abs(equalError), 3.0) << "equal units should stop before they move the depth";
+
+  // With three views the scale is ignored: the same search, evaluation for evaluation.
+  Prepared p = preparePhantom();
+  auto threeEqual = fct::Registration::run(p.registrationCase, start, oneViewLocalOptions(1.0));
+  auto threeScaled = fct::Registration::run(p.registrationCase, start, oneViewLocalOptions(10.0));
+  ASSERT_TRUE(threeEqual.ok() && threeScaled.ok());
+  EXPECT_EQ(threeEqual.value().T_world_from_ct.matrix(), threeScaled.value().T_world_from_ct.matrix());
+}
+
 TEST(Registration, ShiftPrealignmentMovesAFarStartOnceAndTheRunEndsAtTheTruth) {
   Prepared p = preparePhantom();
   fct::RegistrationOptions options = fastOptions(3, fct::RegistrationSchedule::kDefaultPreset);

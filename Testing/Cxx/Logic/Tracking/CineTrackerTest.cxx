@@ -117,6 +117,18 @@ TEST(CineTracker, RejectsBadOptionsAndFrames) {
   options = fastTracker();
   options.dissimilarityGrowth = 1.0;
   EXPECT_FALSE(fct::CineTracker::create(t.registrationCase, options).ok());
+  for (const double badScale : {0.5, 101.0, std::nan("")}) {
+    options = fastTracker();
+    options.depthScale = badScale;
+    auto rejected = fct::CineTracker::create(t.registrationCase, options);
+    ASSERT_FALSE(rejected.ok()) << badScale;
+    EXPECT_NE(rejected.error().find("depth scale"), std::string::npos) << rejected.error();
+  }
+  options = fastTracker();
+  options.frameDrr = fct::DrrMethod::Transgraph;
+  auto tableFrames = fct::CineTracker::create(t.registrationCase, options);
+  ASSERT_FALSE(tableFrames.ok());
+  EXPECT_NE(tableFrames.error().find("raycast or siddon"), std::string::npos) << tableFrames.error();
 
   auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
   ASSERT_TRUE(tracker.ok()) << tracker.error();
@@ -172,6 +184,32 @@ TEST(RegistrationCase, ReplaceXrayPreparesTheNewFrameAndKeepsTheViewOnBadInput) 
   EXPECT_EQ(c.prepared(0).pyramid.level(1).image.pixels, frame1);
 }
 
+TEST(CineTracker, OneViewFramesRenderTrilinearDrrsWithTheDepthScaleAndTwoViewsBoxVoxels) {
+  Tracked t = prepare(1, 1);  // a Siddon case: the frame stage renders exactly, with the frame DRR method
+  auto tracker = fct::CineTracker::create(t.registrationCase, fastTracker());
+  ASSERT_TRUE(tracker.ok()) << tracker.error();
+  const fct::RegistrationStage& stage = tracker.value().frameSchedule().stages.front();
+  EXPECT_TRUE(stage.exactDrr);
+  ASSERT_TRUE(stage.drrMethod.has_value());
+  EXPECT_EQ(*stage.drrMethod, fct::DrrMethod::RayCast);
+  EXPECT_EQ(tracker.value().options().frameDrr, fct::DrrMethod::RayCast) << "the automatic choice, resolved";
+  EXPECT_EQ(stage.drrStep_voxels, fct::CineTrackerOptions::kFrameRayCastStep_voxels);
+  EXPECT_EQ(stage.depthScale, fct::CineTrackerOptions{}.depthScale);
+  Tracked biplane = prepare(1, 2);
+  auto twoViews = fct::CineTracker::create(biplane.registrationCase, fastTracker());
+  ASSERT_TRUE(twoViews.ok()) << twoViews.error();
+  EXPECT_EQ(twoViews.value().frameSchedule().stages.front().drrMethod, fct::DrrMethod::Siddon);
+  EXPECT_EQ(twoViews.value().frameSchedule().stages.front().drrStep_voxels, 0.0);
+  fct::CineTrackerOptions boxVoxels = fastTracker();
+  boxVoxels.frameDrr = fct::DrrMethod::Siddon;
+  boxVoxels.depthScale = 1.0;
+  auto siddon = fct::CineTracker::create(t.registrationCase, boxVoxels);
+  ASSERT_TRUE(siddon.ok()) << siddon.error();
+  EXPECT_EQ(*siddon.value().frameSchedule().stages.front().drrMethod, fct::DrrMethod::Siddon);
+  EXPECT_EQ(siddon.value().frameSchedule().stages.front().drrStep_voxels, 0.0);
+  EXPECT_EQ(siddon.value().frameSchedule().stages.front().depthScale, 1.0);
+}
+
 TEST(CineTracker, ExactRefinementFollowsTheFrameStage) {
   Tracked t = prepare(3);
   fct::CineTrackerOptions options = fastTracker();
@@ -180,6 +218,7 @@ TEST(CineTracker, ExactRefinementFollowsTheFrameStage) {
   ASSERT_TRUE(tracker.ok()) << tracker.error();
   ASSERT_EQ(tracker.value().frameSchedule().stages.size(), 2u);
   EXPECT_TRUE(tracker.value().frameSchedule().stages.back().exactDrr);
+  EXPECT_EQ(tracker.value().frameSchedule().stages.back().drrMethod, fct::DrrMethod::Siddon) << "two views";
   EXPECT_EQ(tracker.value().frameSchedule().stages.back().maxEvaluations, 15);
   ASSERT_TRUE(tracker.value().trackFirst(firstStart(t)).ok());
   for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
