@@ -254,12 +254,14 @@ std::vector<std::string> TrackingStudy::notes(const TrackingStudyDefinition& stu
       study.sourceToIsocentre_mm));
   const CineTrackerOptions trackerDefaults;
   out.push_back(fmt::format("frame 0: registered with the '{}' preset from a random pose at {:g} mm mean sTRE from its "
-                            "truth; later frames: CineTracker defaults (constant-velocity prediction, single-plane "
-                            "with {:g} of the motion along the viewing ray; local search on VLNC ROIs of {:g} % of the "
-                            "valid pixels at the finest pyramid level at most {} px across; recovery when lost); "
-                            "registration on the original CT, Siddon DRRs",
+                            "truth, Siddon DRRs; later frames: CineTracker defaults (constant-velocity prediction, "
+                            "single-plane with {:g} of the motion along the viewing ray; local search on VLNC ROIs of "
+                            "{:g} % of the valid pixels at the finest pyramid level at most {} px across, single-plane "
+                            "on trilinear DRRs (a sample every {:g} coarse voxels) with a {:g}x step along the ray, "
+                            "biplane on Siddon DRRs; recovery when lost); registration on the original CT",
                             study.preset, study.initialStre_mm, trackerDefaults.depthVelocityFactor,
-                            100.0 * trackerDefaults.roiFraction, CineTracker::kAutomaticLevelSide_px));
+                            100.0 * trackerDefaults.roiFraction, CineTracker::kAutomaticLevelSide_px,
+                            CineTrackerOptions::kFrameRayCastStep_voxels, trackerDefaults.depthScale));
   if (auto schedule = RegistrationSchedule::resolve(study.preset)) {
     for (const std::string& note : schedule.value().stageDrrNotes()) out.push_back("frame 0: the preset's " + note);
   }

@@ -82,7 +82,7 @@ struct CineTrackerOptions {
   /// see the depth anyway, and Siddon is 2-4x faster there (docs/tracking.md).
   std::optional<DrrMethod> frameDrr;
   /// The trilinear frame DRR's sampling step along each ray, in voxels of the coarsened CT (docs/tracking.md).
-  static constexpr double kFrameRayCastStep_voxels = 2.0;
+  static constexpr double kFrameRayCastStep_voxels = 1.5;
   /// With one view: the frame search's scaled unit along the viewing ray in units across it (RegistrationStage::
   /// depthScale), in [1, 100]. The similarity is about 400 times flatter in depth than across the ray. Ignored with
   /// two or more views.
