@@ -116,9 +116,9 @@ int main(int argc, char** argv) {
   const Eigen::Vector3d columns = camera.T_world_from_camera().linear().col(0);
   profile.across1 = (columns - columns.dot(profile.ray) * profile.ray).normalized();
   profile.across2 = profile.ray.cross(profile.across1);
-  fmt::print("frame stage: VLNC on {:.0f} % ROIs at level {}, {} DRRs ({} sample(s) per coarse voxel)\n",
-             100.0 * stage.pixels.targetFraction, stage.level, frameDrr,
-             stage.drrStep_voxels > 0.0 ? 1.0 / stage.drrStep_voxels : 0.0);
+  fmt::print("frame stage: VLNC on {:.0f} % ROIs at level {}, {} DRRs{}\n", 100.0 * stage.pixels.targetFraction,
+             stage.level, frameDrr,
+             stage.drrStep_voxels > 0.0 ? fmt::format(" (a sample every {:g} coarse voxels)", stage.drrStep_voxels) : "");
 
   if (scan_mm > 0.0) {
     fmt::print("across the ray (mm: similarity):");
