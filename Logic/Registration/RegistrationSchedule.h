@@ -91,9 +91,10 @@ struct RegistrationStage {
   CmaEsOptions cmaes;              ///< used by CmaEs
   LocalSearchOptions simplex;      ///< the local search (simplex or BOBYQA): alone (Local) or inside each genetic guess
   /// Local search with one view: > 1 searches the translation across and along the viewing ray (source to the bone
-  /// centre at the stage's start), with the scaled unit along the ray this many times the unit across it. One view sees
-  /// that depth only through the magnification, so the similarity is far flatter along it and a search in equal units
-  /// stops before it moves the depth (docs/tracking.md). 1: the world axes in equal units. JSON "search": "depth_scale".
+  /// centre at the stage's start), with the scaled unit along the ray this many times the unit across it. One view
+  /// sees that depth only through the magnification, so the similarity is far flatter along it and a search in equal
+  /// units stops before it moves the depth (docs/tracking.md). 1: the world axes in equal units. JSON
+  /// "search": "depth_scale".
   double depthScale = 1.0;
 };
 

@@ -142,7 +142,9 @@ CineTracker::CineTracker(RegistrationCase& registrationCase, CineTrackerOptions 
 Result<CineTracker> CineTracker::create(RegistrationCase& registrationCase, const CineTrackerOptions& options) {
   CineTrackerOptions resolved = options;
   if (resolved.level == CineTrackerOptions::kAutomaticLevel) resolved.level = automaticLevel(registrationCase);
-  if (!resolved.frameDrr) resolved.frameDrr = registrationCase.viewCount() == 1 ? DrrMethod::RayCast : DrrMethod::Siddon;
+  if (!resolved.frameDrr) {
+    resolved.frameDrr = registrationCase.viewCount() == 1 ? DrrMethod::RayCast : DrrMethod::Siddon;
+  }
   if (Status valid = checkOptions(resolved, registrationCase.levelCount()); !valid) return fail(valid.error());
   if (resolved.firstFrame.schedule.stages.empty()) {
     auto schedule = RegistrationSchedule::builtin(RegistrationSchedule::kDefaultPreset);

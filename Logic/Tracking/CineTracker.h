@@ -77,14 +77,14 @@ struct CineTrackerOptions {
   /// How the frame stage renders when it renders exactly (a case without Transgraph tables, exactDrr, or the
   /// refinement), on the CT coarsened to the level: RayCast (trilinear samples, one every kFrameRayCastStep_voxels
   /// coarse voxels) or Siddon (exact box voxels); nullopt: RayCast with one view, Siddon with two or more. Box voxels
-  /// make the similarity jump as ray positions cross voxel edges (by up to 0.003 within 0.05 mm in plane on the pelvis
+  /// make the similarity jump as ray positions cross voxel edges (by up to 0.0034 within 0.05 mm in plane on the pelvis
   /// at 1:16), which stops a single-plane search before it finds the depth; trilinear samples keep it smooth. Two views
   /// see the depth anyway, and Siddon is 2-4x faster there (docs/tracking.md).
   std::optional<DrrMethod> frameDrr;
   /// The trilinear frame DRR's sampling step along each ray, in voxels of the coarsened CT (docs/tracking.md).
   static constexpr double kFrameRayCastStep_voxels = 1.5;
   /// With one view: the frame search's scaled unit along the viewing ray in units across it (RegistrationStage::
-  /// depthScale), in [1, 100]. The similarity is about 400 times flatter in depth than across the ray. Ignored with
+  /// depthScale), in [1, 100]. The similarity is several hundred times flatter in depth than across it. Ignored with
   /// two or more views.
   double depthScale = 10.0;
   /// > 0: the frame stage is followed by an exact-DRR BOBYQA refinement at the same level and ROIs with this cap on

@@ -42,7 +42,9 @@ struct Profile {
 Eigen::Isometry3d poseAt(const Profile& profile, const double* p) {
   const Eigen::Vector3d rotation_rad = Eigen::Vector3d(p[0], p[1], p[2]) * M_PI / 180.0;
   Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
-  if (rotation_rad.norm() > 0.0) turn.linear() = Eigen::AngleAxisd(rotation_rad.norm(), rotation_rad.normalized()).matrix();
+  if (rotation_rad.norm() > 0.0) {
+    turn.linear() = Eigen::AngleAxisd(rotation_rad.norm(), rotation_rad.normalized()).matrix();
+  }
   Eigen::Isometry3d T = Eigen::Translation3d(profile.centre_world_mm) * turn *
                         Eigen::Translation3d(-profile.centre_world_mm) * profile.T_truth;
   T.pretranslate(profile.depth_mm * profile.ray + p[3] * profile.across1 + p[4] * profile.across2);
@@ -81,7 +83,8 @@ int main(int argc, char** argv) {
   app.add_option("--pose", posePath, "True pose file {\"T_world_from_ct\": 4x4}")->required();
   app.add_option("--level", trackerOptions.level, "Pyramid level (-1: the tracker's automatic level)")
       ->capture_default_str();
-  app.add_option("--roi-fraction", trackerOptions.roiFraction, "ROI fraction of the frame stage")->capture_default_str();
+  app.add_option("--roi-fraction", trackerOptions.roiFraction, "ROI fraction of the frame stage")
+      ->capture_default_str();
   app.add_option("--frame-drr", frameDrr, "raycast or siddon")->capture_default_str();
   app.add_option("--depths", depths, "Depth offsets along the ray, mm, comma-separated")->capture_default_str();
   app.add_option("--scan-mm", scan_mm, "Also scan across the ray in 21 steps of this many mm (0: no scan)");
@@ -116,9 +119,10 @@ int main(int argc, char** argv) {
   const Eigen::Vector3d columns = camera.T_world_from_camera().linear().col(0);
   profile.across1 = (columns - columns.dot(profile.ray) * profile.ray).normalized();
   profile.across2 = profile.ray.cross(profile.across1);
+  const std::string step =
+      stage.drrStep_voxels > 0.0 ? fmt::format(" (a sample every {:g} coarse voxels)", stage.drrStep_voxels) : "";
   fmt::print("frame stage: VLNC on {:.0f} % ROIs at level {}, {} DRRs{}\n", 100.0 * stage.pixels.targetFraction,
-             stage.level, frameDrr,
-             stage.drrStep_voxels > 0.0 ? fmt::format(" (a sample every {:g} coarse voxels)", stage.drrStep_voxels) : "");
+             stage.level, frameDrr, step);
 
   if (scan_mm > 0.0) {
     fmt::print("across the ray (mm: similarity):");
