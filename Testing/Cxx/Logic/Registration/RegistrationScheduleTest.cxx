@@ -125,7 +125,8 @@ TEST(RegistrationSchedule, DepthScaleIsReadAndWrittenOnlyWhereItIsOn) {
   const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
   ASSERT_TRUE(again.ok()) << again.error();
   EXPECT_EQ(again.value().toJson(), json);
-  for (const auto& stage : RegistrationSchedule::builtin("clinical").value().toJson()["stages"]) {
+  const auto clinical = RegistrationSchedule::builtin("clinical").value().toJson();
+  for (const auto& stage : clinical["stages"]) {
     EXPECT_FALSE(stage["search"].contains("depth_scale")) << "off (1) by default, and off is not written";
   }
 }
