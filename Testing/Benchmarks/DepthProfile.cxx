@@ -59,23 +59,12 @@ double negatedSimilarity(unsigned, const double* p, double*, void* data) {
   return similarity ? -similarity.value() : 2.0;
 }
 
-std::vector<double> parseList(const std::string& text) {
-  std::vector<double> values;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    const std::size_t comma = text.find(',', start);
-    values.push_back(std::stod(text.substr(start, comma - start)));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return values;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Similarity of the tracking frame stage along one view's viewing ray, around a known pose"};
-  std::string ctPath, viewsPath, posePath, frameDrr = "raycast", depths = "-6,-4,-2,-1,0,1,2,4,6";
+  std::string ctPath, viewsPath, posePath, frameDrr = "raycast";
+  std::vector<double> depths_mm{-6.0, -4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 6.0};
   double scan_mm = 0.0;
   fct::CineTrackerOptions trackerOptions;
   app.add_option("--ct", ctPath, "CT volume or DICOM folder")->required();
@@ -86,7 +75,9 @@ int main(int argc, char** argv) {
   app.add_option("--roi-fraction", trackerOptions.roiFraction, "ROI fraction of the frame stage")
       ->capture_default_str();
   app.add_option("--frame-drr", frameDrr, "raycast or siddon")->capture_default_str();
-  app.add_option("--depths", depths, "Depth offsets along the ray, mm, comma-separated")->capture_default_str();
+  app.add_option("--depths", depths_mm, "Depth offsets along the ray, mm, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
   app.add_option("--scan-mm", scan_mm, "Also scan across the ray in 21 steps of this many mm (0: no scan)");
   CLI11_PARSE(app, argc, argv);
 
@@ -132,7 +123,7 @@ int main(int argc, char** argv) {
     }
     fmt::print("\n");
   }
-  for (const double depth_mm : parseList(depths)) {
+  for (const double depth_mm : depths_mm) {
     profile.depth_mm = depth_mm;
     profile.evaluations = 0;
     double p[5] = {0.0, 0.0, 0.0, 0.0, 0.0};

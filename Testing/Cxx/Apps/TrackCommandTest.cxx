@@ -74,31 +74,23 @@ TEST(TrackCommand, BadInputsGiveOneClearErrorLine) {
   run = fct::test::runCli(trackArgs(dir, (dir / "uneven.json").string(), (dir / "out").string()));
   EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
   EXPECT_NE(run.err.find("same number of frames"), std::string::npos) << run.err;
-  // No initial pose, a bad level, a bad --igtl.
+  // No initial pose.
   run = fct::test::runCli(fmt::format("track --ct '{}' --views '{}' --out '{}'", (dir / "ct.nrrd").string(),
                                       (dir / "track_views.json").string(), (dir / "out").string()));
   EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
   EXPECT_NE(run.err.find("--init"), std::string::npos) << run.err;
-  run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) + " --level 5");
-  EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
-  EXPECT_NE(run.err.find("level 5"), std::string::npos) << run.err;
-  run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
-                          " --igtl nohost");
-  EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
-  EXPECT_NE(run.err.find("--igtl"), std::string::npos) << run.err;
-  run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
-                          " --depth-velocity 2");
-  EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
-  EXPECT_NE(run.err.find("depth velocity"), std::string::npos) << run.err;
-  run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
-                          " --depth-scale 0.5");
-  EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
-  EXPECT_NE(run.err.find("depth scale"), std::string::npos) << run.err;
-  for (const char* badDrr : {"transgraph", "box"}) {
-    run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
-                            " --frame-drr " + badDrr);
-    EXPECT_TRUE(fct::test::oneErrorLine(run)) << run.err;
-    EXPECT_NE(run.err.find("--frame-drr"), std::string::npos) << run.err;
+  // Bad options, each with the words its one error line must hold.
+  const std::vector<std::pair<std::string, std::string>> badOptions{
+      {" --level 5", "level 5"},
+      {" --igtl nohost", "--igtl"},
+      {" --depth-velocity 2", "depth velocity"},
+      {" --depth-scale 0.5", "depth scale"},
+      {" --frame-drr transgraph", "--frame-drr"},
+      {" --frame-drr box", "--frame-drr"}};
+  for (const auto& [option, expected] : badOptions) {
+    run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) + option);
+    EXPECT_TRUE(fct::test::oneErrorLine(run)) << option << ": " << run.err;
+    EXPECT_NE(run.err.find(expected), std::string::npos) << option << ": " << run.err;
   }
   EXPECT_FALSE(fs::exists(dir / "out")) << "a run that stops on bad input leaves no output folder";
 }
