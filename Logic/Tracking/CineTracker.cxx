@@ -59,6 +59,14 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   if (!(o.maxJump_mm > 0.0) || !(o.maxJump_deg > 0.0)) {
     return fail(fmt::format("lost-track jump limits must be positive, got {} mm and {} deg", o.maxJump_mm, o.maxJump_deg));
   }
+  if (!(o.confirmGrowth >= o.dissimilarityGrowth && std::isfinite(o.confirmGrowth))) {
+    return fail(fmt::format("lost-track confirmation growth must be at least the dissimilarity growth {}, got {}",
+                            o.dissimilarityGrowth, o.confirmGrowth));
+  }
+  if (!(o.confirmTolerance_mm > 0.0) || !(o.confirmTolerance_deg > 0.0)) {
+    return fail(fmt::format("lost-track confirmation tolerances must be positive, got {} mm and {} deg",
+                            o.confirmTolerance_mm, o.confirmTolerance_deg));
+  }
   return Ok{};
 }
 
@@ -188,13 +196,37 @@ Eigen::Isometry3d CineTracker::predictedPose() const {
   return T_predicted;
 }
 
-bool CineTracker::withinBounds(const TrackedFrame& frame) const {
-  if (!m_level.holds(frame.similarity)) return false;
-  const Eigen::Isometry3d T_delta = frame.T_predicted_world_from_ct.inverse() * frame.T_world_from_ct;
+CineTracker::PoseDistance CineTracker::distanceBetween(const Eigen::Isometry3d& T_a_world_from_ct,
+                                                       const Eigen::Isometry3d& T_b_world_from_ct) const {
   const Eigen::Vector3d& c = m_case->rotationCentre_ct_mm();
-  const double move_mm = (frame.T_world_from_ct * c - frame.T_predicted_world_from_ct * c).norm();
-  const double turn_deg = Eigen::AngleAxisd(T_delta.rotation()).angle() * 180.0 / M_PI;
-  return move_mm <= m_options.maxJump_mm && turn_deg <= m_options.maxJump_deg;
+  const Eigen::Isometry3d T_b_from_a = T_b_world_from_ct * T_a_world_from_ct.inverse();
+  return {(T_b_world_from_ct * c - T_a_world_from_ct * c).norm(),
+          Eigen::AngleAxisd(T_b_from_a.rotation()).angle() * 180.0 / M_PI};
+}
+
+bool CineTracker::withinJumpLimits(const TrackedFrame& frame) const {
+  const PoseDistance jump = distanceBetween(frame.T_predicted_world_from_ct, frame.T_world_from_ct);
+  return jump.move_mm <= m_options.maxJump_mm && jump.turn_deg <= m_options.maxJump_deg;
+}
+
+bool CineTracker::withinBounds(const TrackedFrame& frame) const {
+  return m_level.holds(frame.similarity) && withinJumpLimits(frame);
+}
+
+TrackedFrameStatus CineTracker::judgeRecovery(const Eigen::Isometry3d& T_searched_world_from_ct, TrackedFrame& frame) {
+  if (withinBounds(frame)) return TrackedFrameStatus::Recovered;
+  if (frame.cancelled || !withinJumpLimits(frame) || !(m_level.growthOf(frame.similarity) <= m_options.confirmGrowth)) {
+    return TrackedFrameStatus::Lost;
+  }
+  const PoseDistance apart = distanceBetween(T_searched_world_from_ct, frame.T_world_from_ct);
+  if (apart.move_mm > m_options.confirmTolerance_mm || apart.turn_deg > m_options.confirmTolerance_deg) {
+    return TrackedFrameStatus::Lost;
+  }
+  frame.note = fmt::format("similarity {:.4f} ({:.2f}x the reference dissimilarity); the re-registration confirmed the "
+                           "tracked pose ({:.2f} mm, {:.2f} deg apart): similarity level re-anchored here",
+                           frame.similarity, m_level.growthOf(frame.similarity), apart.move_mm, apart.turn_deg);
+  m_level.reanchor(frame.similarity);
+  return TrackedFrameStatus::Recovered;
 }
 
 Result<TrackedFrame> CineTracker::trackFirst(const Eigen::Isometry3d& T_initial, const std::atomic<bool>* cancel) {
@@ -253,8 +285,9 @@ Result<TrackedFrame> CineTracker::trackNext(const std::vector<XrayImage>& frameI
 
   if (usable) usable = runSchedule(m_frameSchedule, frame.T_predicted_world_from_ct, cancel, frame);
   if (usable && !frame.cancelled && !withinBounds(frame)) {
+    const Eigen::Isometry3d T_searched_world_from_ct = frame.T_world_from_ct;
     usable = runSchedule(m_recoverySchedule, frame.T_predicted_world_from_ct, cancel, frame);
-    if (usable) frame.status = withinBounds(frame) ? TrackedFrameStatus::Recovered : TrackedFrameStatus::Lost;
+    if (usable) frame.status = judgeRecovery(T_searched_world_from_ct, frame);
   }
   if (!usable) {
     frame.status = TrackedFrameStatus::Lost;

@@ -12,7 +12,10 @@
 // and frame 0's, so that a slow fall cannot drag the reference down with it; SimilarityLevel), or whose pose differs
 // from the prediction by more than the jump limits, is re-registered from the prediction with the global stage(s) of
 // the first-frame schedule followed by the frame stage(s): it is `Recovered` when that restores the level (and the jump
-// limits hold), else `Lost` (the next frame then starts from the last trusted pose without velocity).
+// limits hold), or when it confirms the frame stage's pose (within the confirmation tolerances, and the dissimilarity
+// within confirmGrowth times the reference): the image content, not the track, lowered the similarity, and the level is
+// re-anchored at that frame. Otherwise it is `Lost` (the next frame then starts from the last trusted pose without
+// velocity).
 
 #include <Eigen/Geometry>
 
@@ -34,7 +37,7 @@ namespace fct {
 /// How a frame's pose was obtained.
 enum class TrackedFrameStatus {
   Tracked,    ///< the frame stage from the prediction met the lost-track rule's bounds
-  Recovered,  ///< the frame stage did not; the global re-registration restored the similarity level
+  Recovered,  ///< the frame stage did not; the global re-registration restored the level or confirmed the pose
   Lost,       ///< neither did: the pose is the re-registration's best, not trusted for the next prediction
 };
 
@@ -52,8 +55,9 @@ struct TrackedFrame {
   long fallbackRays = 0;     ///< Transgraph rays outside their tables, integrated exactly
   TrackedFrameStatus status = TrackedFrameStatus::Tracked;
   bool cancelled = false;    ///< the cancel flag stopped the frame; the pose is the best so far
-  /// Why a Lost frame could not be searched at all (its X-ray or its ROIs unusable, e.g. a blank frame); the pose is
-  /// then the prediction. Empty otherwise.
+  /// Why a Lost frame could not be searched at all (its X-ray or its ROIs unusable, e.g. a blank frame; the pose is
+  /// then the prediction), or that a Recovered frame's re-registration confirmed the tracked pose and re-anchored the
+  /// similarity level. Empty otherwise.
   std::string note;
 };
 
@@ -102,6 +106,15 @@ struct CineTrackerOptions {
   double levelWeight = 0.2;       ///< weight of a new tracked frame in the running level (exponential mean), 0 < w <= 1
   double maxJump_mm = 8.0;        ///< lost when the rotation centre moves more than this from the prediction, mm
   double maxJump_deg = 6.0;       ///< lost when the rotation differs more than this from the prediction, deg
+  /// A frame whose re-registration does not restore the level is still Recovered (and the level re-anchored there)
+  /// when the re-registration's pose is within these of the frame stage's, the rotation centre's move in mm and the
+  /// rotation in deg: two searches, one local and one global, agree, so the image content lowered the similarity,
+  /// not the track.
+  double confirmTolerance_mm = 1.0;
+  double confirmTolerance_deg = 1.0;
+  /// ... and when its dissimilarity is at most this times the reference (>= dissimilarityGrowth): beyond it the frame
+  /// does not show the bone as the CT does (a garbled frame, a dropout), and agreeing poses prove nothing.
+  double confirmGrowth = 3.0;
 };
 
 /// Tracks the bone through a sequence, frame by frame.
@@ -110,8 +123,9 @@ class CineTracker {
   /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
   /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
   /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside
-  /// (0, 1], a non-positive jump limit, a depth velocity factor outside [0, 1], a depth scale outside [1, 100], a frame
-  /// DRR method other than raycast or siddon, or an unknown first-frame preset.
+  /// (0, 1], a non-positive jump limit or confirmation tolerance, a confirmation growth below the dissimilarity growth,
+  /// a depth velocity factor outside [0, 1], a depth scale outside [1, 100], a frame DRR method other than raycast or
+  /// siddon, or an unknown first-frame preset.
   static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
 
   /// Registers frame 0 (the case's current images) with the first-frame schedule from T_initial and sets the running
@@ -144,8 +158,22 @@ class CineTracker {
   /// parameters about the rotation centre; with one view only depthVelocityFactor of its part along the viewing ray),
   /// or the last trusted pose itself without a second pose or with constantVelocity off.
   Eigen::Isometry3d predictedPose() const;
-  /// True when `frame` passes the lost-track rule against the running level and its prediction.
+  /// How far apart two poses are: the rotation centre's move and the rotation between them.
+  struct PoseDistance {
+    double move_mm = 0.0;
+    double turn_deg = 0.0;
+  };
+  /// The distance from pose a to pose b (both CT mm -> world mm).
+  PoseDistance distanceBetween(const Eigen::Isometry3d& T_a_world_from_ct,
+                               const Eigen::Isometry3d& T_b_world_from_ct) const;
+  /// True when `frame`'s pose is within the jump limits of its prediction.
+  bool withinJumpLimits(const TrackedFrame& frame) const;
+  /// True when `frame` passes the lost-track rule against the similarity level and its prediction.
   bool withinBounds(const TrackedFrame& frame) const;
+  /// The status of a re-registered frame (the frame stage had ended at T_searched_world_from_ct): Recovered when within
+  /// bounds, or when it confirms the searched pose within the confirmation tolerances and growth (then the level is
+  /// re-anchored and the note says so); Lost otherwise.
+  TrackedFrameStatus judgeRecovery(const Eigen::Isometry3d& T_searched_world_from_ct, TrackedFrame& frame);
 
   RegistrationCase* m_case;
   CineTrackerOptions m_options;

@@ -1,8 +1,11 @@
 #pragma once
 // SimilarityLevel: the similarity half of the lost-track rule. It keeps the running level of the tracked frames'
-// similarity (an exponential mean) and frame 0's, and judges a frame by its dissimilarity 1 - similarity against the
-// smaller of the two levels' dissimilarities: a track that drifts off lowers its similarity over several frames, and a
-// reference that followed it down would never flag it.
+// similarity (an exponential mean) and an anchor level (frame 0's), and judges a frame by its dissimilarity
+// 1 - similarity against the smaller of the two levels' dissimilarities: a track that drifts off lowers its similarity
+// over several frames, and a reference that followed it down would never flag it. The image content can lower the
+// similarity too (the bone moves to where soft tissue or the field's edge spoils the match); when a re-registration
+// confirms the tracked pose of such a frame, the tracker moves the anchor to it (reanchor), and the next frames are
+// judged against the new scene.
 
 namespace fct {
 
@@ -15,21 +18,28 @@ class SimilarityLevel {
 
   /// A placeholder until frame 0's similarity is known (CineTracker replaces it in trackFirst, before any judgement).
   SimilarityLevel() = default;
-  /// Starts both levels at frame 0's similarity; `growth` (> 1) is the tolerated growth of the dissimilarity, `weight`
-  /// (0 < w <= 1) a new frame's weight in the running level. Callers check the ranges (CineTracker::create).
+  /// Starts both levels (running and anchor) at frame 0's similarity; `growth` (> 1) is the tolerated growth of the
+  /// dissimilarity, `weight` (0 < w <= 1) a new frame's weight in the running level. Callers check the ranges
+  /// (CineTracker::create).
   SimilarityLevel(double firstSimilarity, double growth, double weight);
 
   /// True when 1 - similarity <= growth x referenceDissimilarity() (false for NaN).
   bool holds(double similarity) const;
+  /// The growth of a frame's dissimilarity over the reference: (1 - similarity) / referenceDissimilarity() (NaN for
+  /// NaN). holds() is growthOf() <= the level's growth.
+  double growthOf(double similarity) const;
+  /// Makes `similarity` both levels' value (a re-registration confirmed a frame's pose with it): the next frames are
+  /// judged against the frame's scene, not frame 0's.
+  void reanchor(double similarity) { m_anchor = m_running = similarity; }
   /// Folds a trusted frame's similarity into the running level.
   void follow(double similarity);
   /// The running level (exponential mean of the trusted frames' similarity, frame 0 included).
   double running() const { return m_running; }
-  /// max(kMinReferenceDissimilarity, min(1 - running level, 1 - frame 0's similarity)).
+  /// max(kMinReferenceDissimilarity, min(1 - running level, 1 - anchor level)).
   double referenceDissimilarity() const;
 
  private:
-  double m_first = 0.0;
+  double m_anchor = 0.0;  ///< frame 0's similarity, or the last re-anchored frame's
   double m_running = 0.0;
   double m_growth = 1.0;
   double m_weight = 1.0;

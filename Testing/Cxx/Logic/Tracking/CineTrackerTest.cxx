@@ -1,5 +1,5 @@
 // CineTracker: follows a short simulated sequence (physical simulator, moving phantom bone) frame by frame, flags a
-// dropout frame and recovers after it; RegistrationCase::replaceXray (the frame swap); bad input.
+// dropout frame and recovers after it, keeps frames whose re-registration confirms the pose; RegistrationCase::replaceXray (the frame swap); bad input.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,6 +50,22 @@ Eigen::Isometry3d firstStart(const Tracked& t) {
   Eigen::Isometry3d T = t.sequence.T_truth[0];
   T.translation() += Eigen::Vector3d(2.0, -1.5, 1.5);
   return T;
+}
+
+/// Blends every pixel away from the border with the mean of its 3x3 neighbourhood: (1 - a) x pixel + a x mean.
+void soften(fct::XrayImage& image, double a) {
+  std::vector<float> out = image.pixels;
+  for (int row = 1; row + 1 < image.rows; ++row) {
+    for (int col = 1; col + 1 < image.cols; ++col) {
+      double sum = 0.0;
+      for (int dr = -1; dr <= 1; ++dr) {
+        for (int dc = -1; dc <= 1; ++dc) sum += image.at(col + dc, row + dr);
+      }
+      out[static_cast<std::size_t>(row) * image.cols + col] = static_cast<float>((1.0 - a) * image.at(col, row) +
+                                                                                 a * sum / 9.0);
+    }
+  }
+  image.pixels = std::move(out);
 }
 
 }  // namespace
@@ -124,6 +140,14 @@ TEST(CineTracker, RejectsBadOptionsAndFrames) {
     ASSERT_FALSE(rejected.ok()) << badScale;
     EXPECT_NE(rejected.error().find("depth scale"), std::string::npos) << rejected.error();
   }
+  options = fastTracker();
+  options.confirmGrowth = 1.5;  // below the dissimilarity growth (1.75)
+  auto confirmGrowth = fct::CineTracker::create(t.registrationCase, options);
+  ASSERT_FALSE(confirmGrowth.ok());
+  EXPECT_NE(confirmGrowth.error().find("confirmation growth"), std::string::npos) << confirmGrowth.error();
+  options = fastTracker();
+  options.confirmTolerance_deg = 0.0;
+  EXPECT_FALSE(fct::CineTracker::create(t.registrationCase, options).ok());
   options = fastTracker();
   options.frameDrr = fct::DrrMethod::Transgraph;
   auto tableFrames = fct::CineTracker::create(t.registrationCase, options);
@@ -269,4 +293,51 @@ TEST(CineTracker, SinglePlanePredictionCarriesOnlyPartOfTheMotionAlongTheViewing
     ASSERT_FALSE(rejected.ok()) << bad;
     EXPECT_NE(rejected.error().find("depth velocity"), std::string::npos) << rejected.error();
   }
+}
+
+TEST(CineTracker, ReRegistrationThatConfirmsThePoseKeepsAFrameWhoseImageSpoilsTheMatch) {
+  // Every frame softer than the last (a = 0.2 per frame, as motion blur or a growing overlay would): the similarity
+  // falls from about 0.99 to 0.98 while the pose stays right, until a frame exceeds 1.75x the reference dissimilarity.
+  Tracked t = prepare(8);
+  for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
+    for (fct::XrayImage& image : t.sequence.frames[f]) soften(image, std::min(1.0, 0.2 * static_cast<double>(f)));
+  }
+  const auto track = [&t](const fct::CineTrackerOptions& options) {
+    auto tracker = fct::CineTracker::create(t.registrationCase, options);
+    EXPECT_TRUE(tracker.ok()) << tracker.error();
+    std::vector<fct::TrackedFrame> frames;
+    for (std::size_t v = 0; v < t.sequence.views.size(); ++v) {  // trackFirst registers the case's current images
+      EXPECT_TRUE(t.registrationCase.replaceXray(v, t.sequence.frames[0][v]).ok());
+    }
+    if (!tracker.ok() || !tracker.value().trackFirst(firstStart(t)).ok()) return frames;
+    for (std::size_t f = 1; f < t.sequence.frames.size(); ++f) {
+      auto frame = tracker.value().trackNext(t.sequence.frames[f]);
+      EXPECT_TRUE(frame.ok()) << frame.error();
+      if (!frame.ok()) break;
+      std::printf("frame %zu: %s, similarity %.4f, error %.3f mm %s\n", f,
+                  fct::CineTracker::statusName(frame.value().status), frame.value().similarity,
+                  errorOf(t, frame.value()), frame.value().note.c_str());
+      frames.push_back(frame.value());
+    }
+    return frames;
+  };
+  const auto count = [](const std::vector<fct::TrackedFrame>& frames, fct::TrackedFrameStatus status) {
+    return std::count_if(frames.begin(), frames.end(), [status](const fct::TrackedFrame& f) { return f.status == status; });
+  };
+
+  const std::vector<fct::TrackedFrame> confirmed = track(fastTracker());
+  ASSERT_EQ(confirmed.size(), t.sequence.frames.size() - 1);
+  EXPECT_EQ(count(confirmed, fct::TrackedFrameStatus::Lost), 0);
+  EXPECT_GE(count(confirmed, fct::TrackedFrameStatus::Recovered), 1);
+  for (const fct::TrackedFrame& frame : confirmed) {
+    EXPECT_LT(errorOf(t, frame), 1.5) << "frame " << frame.index;  // the softened frames cost accuracy: 1.0 mm seen
+    if (frame.status == fct::TrackedFrameStatus::Recovered) {
+      EXPECT_NE(frame.note.find("confirmed the tracked pose"), std::string::npos) << frame.note;
+    }
+  }
+
+  // The same frames when the two searches must agree within 0.01 mm: the suspect frame is lost.
+  fct::CineTrackerOptions strict = fastTracker();
+  strict.confirmTolerance_mm = 0.01;
+  EXPECT_GE(count(track(strict), fct::TrackedFrameStatus::Lost), 1);
 }

@@ -68,3 +68,18 @@ TEST(SimilarityLevel, RefusesNaNAndFollowsRisingLevels) {
   EXPECT_NEAR(level.referenceDissimilarity(), 0.12, 1e-12);
   EXPECT_FALSE(level.holds(0.75));
 }
+
+TEST(SimilarityLevel, GrowthOfAFrameAndReanchoringAtAConfirmedFrame) {
+  // The pelvis biplane sequence whose scene lowered the similarity: frame 0 at 0.961, the running level near 0.940.
+  SimilarityLevel level(0.961, 1.75, 0.2);
+  for (const double s : {0.955, 0.950, 0.945, 0.944, 0.940, 0.934}) level.follow(s);
+  EXPECT_NEAR(level.referenceDissimilarity(), 0.039, 1e-12);  // frame 0's is the smaller
+  EXPECT_NEAR(level.growthOf(0.919), 0.081 / 0.039, 1e-9);
+  EXPECT_FALSE(level.holds(0.919));
+  EXPECT_TRUE(std::isnan(level.growthOf(std::nan(""))));
+  level.reanchor(0.919);  // a re-registration confirmed that frame's pose
+  EXPECT_DOUBLE_EQ(level.running(), 0.919);
+  EXPECT_NEAR(level.referenceDissimilarity(), 0.081, 1e-12);
+  EXPECT_TRUE(level.holds(0.905));
+  EXPECT_FALSE(level.holds(0.85));  // 0.15 > 1.75 x 0.081
+}
