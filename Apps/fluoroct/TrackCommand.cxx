@@ -168,8 +168,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                   {"max_jump_mm", run.tracker.maxJump_mm},
                                   {"max_jump_deg", run.tracker.maxJump_deg},
                                   {"confirm_mm", run.tracker.confirmTolerance_mm},
-                                  {"confirm_deg", run.tracker.confirmTolerance_deg},
-                                  {"confirm_growth", run.tracker.confirmGrowth}}}};
+                                  {"confirm_deg", run.tracker.confirmTolerance_deg}}}};
 }
 
 std::string trackCsv(const TrackRun& run) {
@@ -376,15 +375,12 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
                       "Lost track: rotation more than this from the prediction (deg)")
       ->capture_default_str();
   command->add_option("--confirm-mm", options->tracker.confirmTolerance_mm,
-                      "Lost track: a suspect frame is kept (recovered, the similarity level re-anchored there) when "
-                      "its re-registration lands within this of the tracked pose (bone centre, mm)")
+                      "Lost track: a suspect frame whose similarity fell gradually is kept (recovered, the similarity "
+                      "level re-anchored there) when its re-registration lands within this of the tracked pose (bone "
+                      "centre, mm)")
       ->capture_default_str();
   command->add_option("--confirm-deg", options->tracker.confirmTolerance_deg,
                       "Lost track: the confirmation's rotation tolerance (deg)")
-      ->capture_default_str();
-  command->add_option("--confirm-growth", options->tracker.confirmGrowth,
-                      "Lost track: the confirmation holds only up to this times the reference dissimilarity (at "
-                      "least --dissimilarity-growth)")
       ->capture_default_str();
   command->add_flag("--no-fov", options->noFieldOfView, "Skip the field-of-view (collimator) detection");
   command->add_flag("--no-metal-mask", options->noMetalMask, "Compare metal shadows too instead of excluding them");

@@ -59,10 +59,6 @@ Status checkOptions(const CineTrackerOptions& o, int levelCount) {
   if (!(o.maxJump_mm > 0.0) || !(o.maxJump_deg > 0.0)) {
     return fail(fmt::format("lost-track jump limits must be positive, got {} mm and {} deg", o.maxJump_mm, o.maxJump_deg));
   }
-  if (!(o.confirmGrowth >= o.dissimilarityGrowth && std::isfinite(o.confirmGrowth))) {
-    return fail(fmt::format("lost-track confirmation growth must be at least the dissimilarity growth {}, got {}",
-                            o.dissimilarityGrowth, o.confirmGrowth));
-  }
   if (!(o.confirmTolerance_mm > 0.0) || !(o.confirmTolerance_deg > 0.0)) {
     return fail(fmt::format("lost-track confirmation tolerances must be positive, got {} mm and {} deg",
                             o.confirmTolerance_mm, o.confirmTolerance_deg));
@@ -215,16 +211,16 @@ bool CineTracker::withinBounds(const TrackedFrame& frame) const {
 
 TrackedFrameStatus CineTracker::judgeRecovery(const Eigen::Isometry3d& T_searched_world_from_ct, TrackedFrame& frame) {
   if (withinBounds(frame)) return TrackedFrameStatus::Recovered;
-  if (frame.cancelled || !withinJumpLimits(frame) || !(m_level.growthOf(frame.similarity) <= m_options.confirmGrowth)) {
+  if (frame.cancelled || !withinJumpLimits(frame) || !m_level.fellGradually(frame.similarity)) {
     return TrackedFrameStatus::Lost;
   }
   const PoseDistance apart = distanceBetween(T_searched_world_from_ct, frame.T_world_from_ct);
   if (apart.move_mm > m_options.confirmTolerance_mm || apart.turn_deg > m_options.confirmTolerance_deg) {
     return TrackedFrameStatus::Lost;
   }
-  frame.note = fmt::format("similarity {:.4f} ({:.2f}x the reference dissimilarity); the re-registration confirmed the "
-                           "tracked pose ({:.2f} mm, {:.2f} deg apart): similarity level re-anchored here",
-                           frame.similarity, m_level.growthOf(frame.similarity), apart.move_mm, apart.turn_deg);
+  frame.note = fmt::format("similarity {:.4f} fell gradually (last frame {:.4f}) below the level; the re-registration "
+                           "confirmed the tracked pose ({:.2f} mm, {:.2f} deg apart): level re-anchored here",
+                           frame.similarity, m_level.last(), apart.move_mm, apart.turn_deg);
   m_level.reanchor(frame.similarity);
   return TrackedFrameStatus::Recovered;
 }

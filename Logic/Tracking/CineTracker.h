@@ -12,10 +12,10 @@
 // and frame 0's, so that a slow fall cannot drag the reference down with it; SimilarityLevel), or whose pose differs
 // from the prediction by more than the jump limits, is re-registered from the prediction with the global stage(s) of
 // the first-frame schedule followed by the frame stage(s): it is `Recovered` when that restores the level (and the jump
-// limits hold), or when it confirms the frame stage's pose (within the confirmation tolerances, and the dissimilarity
-// within confirmGrowth times the reference): the image content, not the track, lowered the similarity, and the level is
-// re-anchored at that frame. Otherwise it is `Lost` (the next frame then starts from the last trusted pose without
-// velocity).
+// limits hold), or when it confirms the frame stage's pose (within the confirmation tolerances) of a frame whose
+// dissimilarity grew at most dissimilarityGrowth times over the last trusted frame's: the image content, not the track,
+// lowered the similarity, and the level is re-anchored at that frame. Otherwise it is `Lost` (the next frame then
+// starts from the last trusted pose without velocity).
 
 #include <Eigen/Geometry>
 
@@ -107,14 +107,11 @@ struct CineTrackerOptions {
   double maxJump_mm = 8.0;        ///< lost when the rotation centre moves more than this from the prediction, mm
   double maxJump_deg = 6.0;       ///< lost when the rotation differs more than this from the prediction, deg
   /// A frame whose re-registration does not restore the level is still Recovered (and the level re-anchored there)
-  /// when the re-registration's pose is within these of the frame stage's, the rotation centre's move in mm and the
-  /// rotation in deg: two searches, one local and one global, agree, so the image content lowered the similarity,
-  /// not the track.
+  /// when its similarity fell gradually (SimilarityLevel::fellGradually) and the re-registration's pose is within these
+  /// of the frame stage's, the rotation centre's move in mm and the rotation in deg: two searches, one local and one
+  /// global, agree, so the image content lowered the similarity, not the track.
   double confirmTolerance_mm = 1.0;
   double confirmTolerance_deg = 1.0;
-  /// ... and when its dissimilarity is at most this times the reference (>= dissimilarityGrowth): beyond it the frame
-  /// does not show the bone as the CT does (a garbled frame, a dropout), and agreeing poses prove nothing.
-  double confirmGrowth = 3.0;
 };
 
 /// Tracks the bone through a sequence, frame by frame.
@@ -123,9 +120,8 @@ class CineTracker {
   /// A tracker on a case prepared on frame 0's images (RegistrationCase::create); it keeps a reference to the case,
   /// which must outlive it. Fails on a frame-stage level the case's pyramid lacks, a window outside 2..64, a fraction
   /// outside (0, 1], a non-positive cap, step or tolerance, a dissimilarity growth not above 1, a level weight outside
-  /// (0, 1], a non-positive jump limit or confirmation tolerance, a confirmation growth below the dissimilarity growth,
-  /// a depth velocity factor outside [0, 1], a depth scale outside [1, 100], a frame DRR method other than raycast or
-  /// siddon, or an unknown first-frame preset.
+  /// (0, 1], a non-positive jump limit or confirmation tolerance, a depth velocity factor outside [0, 1], a depth scale
+  /// outside [1, 100], a frame DRR method other than raycast or siddon, or an unknown first-frame preset.
   static Result<CineTracker> create(RegistrationCase& registrationCase, const CineTrackerOptions& options);
 
   /// Registers frame 0 (the case's current images) with the first-frame schedule from T_initial and sets the running
@@ -171,8 +167,8 @@ class CineTracker {
   /// True when `frame` passes the lost-track rule against the similarity level and its prediction.
   bool withinBounds(const TrackedFrame& frame) const;
   /// The status of a re-registered frame (the frame stage had ended at T_searched_world_from_ct): Recovered when within
-  /// bounds, or when it confirms the searched pose within the confirmation tolerances and growth (then the level is
-  /// re-anchored and the note says so); Lost otherwise.
+  /// bounds, or when its similarity fell gradually and it confirms the searched pose within the confirmation
+  /// tolerances (then the level is re-anchored and the note says so); Lost otherwise.
   TrackedFrameStatus judgeRecovery(const Eigen::Isometry3d& T_searched_world_from_ct, TrackedFrame& frame);
 
   RegistrationCase* m_case;

@@ -4,8 +4,8 @@
 // 1 - similarity against the smaller of the two levels' dissimilarities: a track that drifts off lowers its similarity
 // over several frames, and a reference that followed it down would never flag it. The image content can lower the
 // similarity too (the bone moves to where soft tissue or the field's edge spoils the match); when a re-registration
-// confirms the tracked pose of such a frame, the tracker moves the anchor to it (reanchor), and the next frames are
-// judged against the new scene.
+// confirms the tracked pose of a frame whose similarity fell gradually (fellGradually), the tracker moves the levels to
+// it (reanchor), and the next frames are judged against the new scene.
 
 namespace fct {
 
@@ -25,14 +25,17 @@ class SimilarityLevel {
 
   /// True when 1 - similarity <= growth x referenceDissimilarity() (false for NaN).
   bool holds(double similarity) const;
-  /// The growth of a frame's dissimilarity over the reference: (1 - similarity) / referenceDissimilarity() (NaN for
-  /// NaN). holds() is growthOf() <= the level's growth.
-  double growthOf(double similarity) const;
-  /// Makes `similarity` both levels' value (a re-registration confirmed a frame's pose with it): the next frames are
-  /// judged against the frame's scene, not frame 0's.
-  void reanchor(double similarity) { m_anchor = m_running = similarity; }
-  /// Folds a trusted frame's similarity into the running level.
+  /// True when 1 - similarity <= growth x max(kMinReferenceDissimilarity, 1 - the last trusted frame's similarity)
+  /// (false for NaN): the similarity fell gradually, as it does when the scene changes, not at once, as it does when a
+  /// track jumps off or a frame is garbled.
+  bool fellGradually(double similarity) const;
+  /// Makes `similarity` every level's value (a re-registration confirmed a frame's pose with it): the next frames are
+  /// judged against that frame's scene, not frame 0's.
+  void reanchor(double similarity) { m_anchor = m_running = m_last = similarity; }
+  /// Folds a trusted frame's similarity into the running level; it becomes the last trusted frame's.
   void follow(double similarity);
+  /// The last trusted frame's similarity (frame 0's at the start).
+  double last() const { return m_last; }
   /// The running level (exponential mean of the trusted frames' similarity, frame 0 included).
   double running() const { return m_running; }
   /// max(kMinReferenceDissimilarity, min(1 - running level, 1 - anchor level)).
@@ -41,6 +44,7 @@ class SimilarityLevel {
  private:
   double m_anchor = 0.0;  ///< frame 0's similarity, or the last re-anchored frame's
   double m_running = 0.0;
+  double m_last = 0.0;
   double m_growth = 1.0;
   double m_weight = 1.0;
 };

@@ -87,7 +87,6 @@ TEST(TrackCommand, BadInputsGiveOneClearErrorLine) {
       {" --depth-scale 0.5", "depth scale"},
       {" --frame-drr transgraph", "--frame-drr"},
       {" --frame-drr box", "--frame-drr"},
-      {" --confirm-growth 1.5", "confirmation growth"},
       {" --confirm-mm 0", "confirmation tolerances"}};
   for (const auto& [option, expected] : badOptions) {
     run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) + option);

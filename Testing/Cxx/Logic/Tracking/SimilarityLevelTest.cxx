@@ -69,16 +69,19 @@ TEST(SimilarityLevel, RefusesNaNAndFollowsRisingLevels) {
   EXPECT_FALSE(level.holds(0.75));
 }
 
-TEST(SimilarityLevel, GrowthOfAFrameAndReanchoringAtAConfirmedFrame) {
-  // The pelvis biplane sequence whose scene lowered the similarity: frame 0 at 0.961, the running level near 0.940.
+TEST(SimilarityLevel, TellsAGradualFallFromASuddenOneAndReanchorsAtAConfirmedFrame) {
+  // The pelvis biplane sequence whose scene lowered the similarity: frame 0 at 0.961, then slowly down to 0.934.
   SimilarityLevel level(0.961, 1.75, 0.2);
   for (const double s : {0.955, 0.950, 0.945, 0.944, 0.940, 0.934}) level.follow(s);
+  EXPECT_DOUBLE_EQ(level.last(), 0.934);
   EXPECT_NEAR(level.referenceDissimilarity(), 0.039, 1e-12);  // frame 0's is the smaller
-  EXPECT_NEAR(level.growthOf(0.919), 0.081 / 0.039, 1e-9);
-  EXPECT_FALSE(level.holds(0.919));
-  EXPECT_TRUE(std::isnan(level.growthOf(std::nan(""))));
+  EXPECT_FALSE(level.holds(0.919));                            // 0.081 > 1.75 x 0.039
+  EXPECT_TRUE(level.fellGradually(0.919));                     // 0.081 <= 1.75 x 0.066
+  EXPECT_FALSE(level.fellGradually(0.850));                    // the drifting track above: 0.150 > 1.75 x 0.066
+  EXPECT_FALSE(level.fellGradually(std::nan("")));
   level.reanchor(0.919);  // a re-registration confirmed that frame's pose
   EXPECT_DOUBLE_EQ(level.running(), 0.919);
+  EXPECT_DOUBLE_EQ(level.last(), 0.919);
   EXPECT_NEAR(level.referenceDissimilarity(), 0.081, 1e-12);
   EXPECT_TRUE(level.holds(0.905));
   EXPECT_FALSE(level.holds(0.85));  // 0.15 > 1.75 x 0.081
