@@ -5,7 +5,11 @@
 namespace fct {
 
 SimilarityLevel::SimilarityLevel(double firstSimilarity, double growth, double weight)
-    : m_anchor(firstSimilarity), m_running(firstSimilarity), m_last(firstSimilarity), m_growth(growth), m_weight(weight) {}
+    : m_anchor(firstSimilarity),
+      m_running(firstSimilarity),
+      m_last(firstSimilarity),
+      m_growth(growth),
+      m_weight(weight) {}
 
 bool SimilarityLevel::holds(double similarity) const {
   return 1.0 - similarity <= m_growth * referenceDissimilarity();

@@ -1,5 +1,6 @@
 // CineTracker: follows a short simulated sequence (physical simulator, moving phantom bone) frame by frame, flags a
-// dropout frame and recovers after it, keeps frames whose re-registration confirms the pose; RegistrationCase::replaceXray (the frame swap); bad input.
+// dropout frame and recovers after it, keeps frames whose re-registration confirms the pose;
+// RegistrationCase::replaceXray (the frame swap); bad input.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -319,7 +320,8 @@ TEST(CineTracker, ReRegistrationThatConfirmsThePoseKeepsAFrameWhoseImageSpoilsTh
     return frames;
   };
   const auto count = [](const std::vector<fct::TrackedFrame>& frames, fct::TrackedFrameStatus status) {
-    return std::count_if(frames.begin(), frames.end(), [status](const fct::TrackedFrame& f) { return f.status == status; });
+    return std::count_if(frames.begin(), frames.end(),
+                         [status](const fct::TrackedFrame& f) { return f.status == status; });
   };
 
   const std::vector<fct::TrackedFrame> confirmed = track(fastTracker());
