@@ -176,8 +176,10 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
   centredText(image, spec.xLabel, (left + right) / 2, spec.height_px - 12, kTextScale);
   verticalText(image, spec.yLabel, 8, (top + bottom) / 2);
 
-  // Series, clipped to the plot area.
+  // Series, clipped to the plot area; `drawn` marks their pixels (in image coordinates) for the legend's placement.
   cv::Mat plot = image(cv::Rect(left, top, right - left + 1, bottom - top + 1));
+  cv::Mat drawn(image.rows, image.cols, CV_8U, cv::Scalar(0));
+  cv::Mat drawnPlot = drawn(cv::Rect(left, top, right - left + 1, bottom - top + 1));
   const cv::Point origin(left, top);
   for (std::size_t n = 0; n < spec.series.size(); ++n) {
     const ChartSeries& s = spec.series[n];
@@ -191,20 +193,36 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
     for (std::size_t i = 0; i < points.size(); ++i) {
       const cv::Point p(px(points[i].first), py(points[i].second));
       if (s.lines && i > 0) {
-        cv::line(plot, cv::Point(px(points[i - 1].first), py(points[i - 1].second)) - origin, p - origin, bgr(n), 2,
-                 cv::LINE_AA);
+        const cv::Point previous(px(points[i - 1].first), py(points[i - 1].second));
+        cv::line(plot, previous - origin, p - origin, bgr(n), 2, cv::LINE_AA);
+        cv::line(drawnPlot, previous - origin, p - origin, cv::Scalar(255), 2);
       }
       drawSeriesMarker(plot, p - origin, n);
+      cv::circle(drawnPlot, p - origin, 6, cv::Scalar(255), cv::FILLED);
     }
   }
 
-  // Legend in the top-right corner of the plot area.
+  // Legend in the corner of the plot area that hides the fewest series pixels (top-right on a tie).
   int legendWidth = 0;
   for (const ChartSeries& s : spec.series) legendWidth = std::max(legendWidth, textSize(s.name, kTextScale).width);
-  const int boxLeft = right - legendWidth - 50, boxTop = top + 8;
-  const int boxHeight = 20 * static_cast<int>(spec.series.size()) + 8;
-  cv::rectangle(image, cv::Rect(boxLeft, boxTop, legendWidth + 42, boxHeight), cv::Scalar(255, 255, 255), cv::FILLED);
-  cv::rectangle(image, cv::Rect(boxLeft, boxTop, legendWidth + 42, boxHeight), cv::Scalar(160, 160, 160), 1);
+  const int boxWidth = legendWidth + 42, boxHeight = 20 * static_cast<int>(spec.series.size()) + 8;
+  const int nearLeft = left + 8, nearRight = right - legendWidth - 50;
+  const int nearTop = top + 8, nearBottom = bottom - 8 - boxHeight;
+  cv::Rect box(nearRight, nearTop, boxWidth, boxHeight);
+  int hidden = std::numeric_limits<int>::max();
+  for (const cv::Point corner : {cv::Point(nearRight, nearTop), cv::Point(nearLeft, nearTop),
+                                 cv::Point(nearRight, nearBottom), cv::Point(nearLeft, nearBottom)}) {
+    const cv::Rect candidate =
+        cv::Rect(corner.x, corner.y, boxWidth, boxHeight) & cv::Rect(0, 0, image.cols, image.rows);
+    const int pixels = candidate.area() > 0 ? cv::countNonZero(drawn(candidate)) : 0;
+    if (pixels < hidden) {
+      hidden = pixels;
+      box = cv::Rect(corner.x, corner.y, boxWidth, boxHeight);
+    }
+  }
+  const int boxLeft = box.x, boxTop = box.y;
+  cv::rectangle(image, box, cv::Scalar(255, 255, 255), cv::FILLED);
+  cv::rectangle(image, box, cv::Scalar(160, 160, 160), 1);
   for (std::size_t n = 0; n < spec.series.size(); ++n) {
     const int row = boxTop + 16 + 20 * static_cast<int>(n);
     if (spec.series[n].lines) {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <set>
+#include <string>
 #include <utility>
 
 #include "Evaluation/LineChart.h"
@@ -37,6 +38,35 @@ TEST(LineChart, DrawsAxesAndEverySeriesInItsColour) {
   EXPECT_TRUE(hasColour(image.value(), {0, 0, 0}));
   EXPECT_TRUE(hasColour(image.value(), fct::LineChart::seriesColour(0)));
   EXPECT_TRUE(hasColour(image.value(), fct::LineChart::seriesColour(1)));
+}
+
+TEST(LineChart, LegendTakesTheCornerThatHidesTheFewestSeriesPixels) {
+  // The legend's frame is the only horizontal run of 30 (160, 160, 160) pixels in a chart (text edges have single
+  // grey pixels); find which corner of the plot area its top edge is in.
+  const auto legendCorner = [](const fct::ChartSpec& spec) {
+    const auto image = fct::LineChart::draw(spec);
+    EXPECT_TRUE(image.ok()) << image.error();
+    const int midCol = (80 + spec.width_px - 20) / 2, midRow = (50 + spec.height_px - 60) / 2;
+    for (int row = 0; row < image.value().rows; ++row) {
+      int run = 0;
+      for (int col = 0; col < image.value().cols; ++col) {
+        run = image.value().at(col, row) == std::array<std::uint8_t, 3>{160, 160, 160} ? run + 1 : 0;
+        if (run == 30) return std::string(row < midRow ? "top" : "bottom") + (col < midCol ? "-left" : "-right");
+      }
+    }
+    return std::string("none");
+  };
+  fct::ChartSpec spec;
+  spec.width_px = 640;
+  spec.height_px = 400;
+  spec.series.push_back({"flat", {0, 10}, {1, 1}, true});  // along the bottom: the top-right corner is free
+  EXPECT_EQ(legendCorner(spec), "top-right");
+  spec.series.front() = {"rising", {0, 10}, {0, 10}, true};  // bottom-left to top-right
+  EXPECT_EQ(legendCorner(spec), "top-left");
+  spec.series.front() = {"falling", {0, 10}, {10, 0}, true};  // top-left to bottom-right
+  EXPECT_EQ(legendCorner(spec), "top-right");
+  spec.series.push_back({"high", {0, 10}, {9.5, 9.5}, true});  // and a line along the top
+  EXPECT_EQ(legendCorner(spec), "bottom-left");
 }
 
 TEST(LineChart, TheFirst28SeriesDifferInColourOrMarker) {
