@@ -176,11 +176,11 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
   centredText(image, spec.xLabel, (left + right) / 2, spec.height_px - 12, kTextScale);
   verticalText(image, spec.yLabel, 8, (top + bottom) / 2);
 
-  // Series, clipped to the plot area; `drawn` marks their pixels (in image coordinates) for the legend's placement.
-  cv::Mat plot = image(cv::Rect(left, top, right - left + 1, bottom - top + 1));
-  cv::Mat drawn(image.rows, image.cols, CV_8U, cv::Scalar(0));
-  cv::Mat drawnPlot = drawn(cv::Rect(left, top, right - left + 1, bottom - top + 1));
-  const cv::Point origin(left, top);
+  // Series, clipped to the plot area; `drawn` marks their pixels (plot-area coordinates) for the legend's placement.
+  const cv::Rect plotArea(left, top, right - left + 1, bottom - top + 1);
+  cv::Mat plot = image(plotArea);
+  cv::Mat drawn(plot.size(), CV_8U, cv::Scalar(0));
+  const cv::Point origin = plotArea.tl();
   for (std::size_t n = 0; n < spec.series.size(); ++n) {
     const ChartSeries& s = spec.series[n];
     std::vector<std::pair<double, double>> points;
@@ -195,10 +195,10 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
       if (s.lines && i > 0) {
         const cv::Point previous(px(points[i - 1].first), py(points[i - 1].second));
         cv::line(plot, previous - origin, p - origin, bgr(n), 2, cv::LINE_AA);
-        cv::line(drawnPlot, previous - origin, p - origin, cv::Scalar(255), 2);
+        cv::line(drawn, previous - origin, p - origin, cv::Scalar(255), 2);
       }
       drawSeriesMarker(plot, p - origin, n);
-      cv::circle(drawnPlot, p - origin, 6, cv::Scalar(255), cv::FILLED);
+      cv::circle(drawn, p - origin, 6, cv::Scalar(255), cv::FILLED);
     }
   }
 
@@ -208,16 +208,16 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
   const int boxWidth = legendWidth + 42, boxHeight = 20 * static_cast<int>(spec.series.size()) + 8;
   const int nearLeft = left + 8, nearRight = right - legendWidth - 50;
   const int nearTop = top + 8, nearBottom = bottom - 8 - boxHeight;
-  cv::Rect box(nearRight, nearTop, boxWidth, boxHeight);
+  cv::Rect box;
   int hidden = std::numeric_limits<int>::max();
   for (const cv::Point corner : {cv::Point(nearRight, nearTop), cv::Point(nearLeft, nearTop),
                                  cv::Point(nearRight, nearBottom), cv::Point(nearLeft, nearBottom)}) {
-    const cv::Rect candidate =
-        cv::Rect(corner.x, corner.y, boxWidth, boxHeight) & cv::Rect(0, 0, image.cols, image.rows);
-    const int pixels = candidate.area() > 0 ? cv::countNonZero(drawn(candidate)) : 0;
+    const cv::Rect candidate(corner, cv::Size(boxWidth, boxHeight));
+    const cv::Rect overPlot = (candidate - origin) & cv::Rect(cv::Point(), drawn.size());
+    const int pixels = overPlot.area() > 0 ? cv::countNonZero(drawn(overPlot)) : 0;
     if (pixels < hidden) {
       hidden = pixels;
-      box = cv::Rect(corner.x, corner.y, boxWidth, boxHeight);
+      box = candidate;
     }
   }
   const int boxLeft = box.x, boxTop = box.y;

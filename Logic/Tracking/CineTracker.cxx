@@ -210,10 +210,9 @@ bool CineTracker::withinBounds(const TrackedFrame& frame) const {
 }
 
 TrackedFrameStatus CineTracker::judgeRecovery(const Eigen::Isometry3d& T_searched_world_from_ct, TrackedFrame& frame) {
-  if (withinBounds(frame)) return TrackedFrameStatus::Recovered;
-  if (frame.cancelled || !withinJumpLimits(frame) || !m_level.fellGradually(frame.similarity)) {
-    return TrackedFrameStatus::Lost;
-  }
+  const bool withinJumps = withinJumpLimits(frame);
+  if (withinJumps && m_level.holds(frame.similarity)) return TrackedFrameStatus::Recovered;
+  if (frame.cancelled || !withinJumps || !m_level.fellGradually(frame.similarity)) return TrackedFrameStatus::Lost;
   const PoseDistance apart = distanceBetween(T_searched_world_from_ct, frame.T_world_from_ct);
   if (apart.move_mm > m_options.confirmTolerance_mm || apart.turn_deg > m_options.confirmTolerance_deg) {
     return TrackedFrameStatus::Lost;
