@@ -377,6 +377,7 @@ Result<StageReport> runStage(const StageContext& context, int stageIndex, const 
   report.metalPiecesGivenBack = start.metalPiecesGivenBack;
   report.hazeViewsCorrected = start.haze.viewsCorrected;
   report.hazeFraction = start.haze.largestHazeFraction;
+  report.hazeHardening = start.haze.largestHardening;
   report.hazeViewsKept = start.haze.viewsKept;
 
   RegistrationProgress progress = startProgress(stage, stageIndex, context.stageCount, startSimilarity);
@@ -431,9 +432,10 @@ std::string stageStartNote(const StageReport& report) {
                                 report.metalPiecesGivenBack, report.metalPiecesGivenBack == 1 ? "" : "s"));
   }
   if (report.hazeViewsCorrected > 0) {
-    notes.push_back(fmt::format("haze removed from {} view{} (up to {:.0f} % of a view's signal)",
+    notes.push_back(fmt::format("haze removed from {} view{} (up to {:.0f} % of a view's signal; beam hardening up to "
+                                "{:.2f})",
                                 report.hazeViewsCorrected, report.hazeViewsCorrected == 1 ? "" : "s",
-                                100.0 * report.hazeFraction));
+                                100.0 * report.hazeFraction, report.hazeHardening));
   }
   for (const std::string& kept : report.hazeViewsKept) notes.push_back("haze not removed from " + kept);
   return fmt::format("{}", fmt::join(notes, "; "));

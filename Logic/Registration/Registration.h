@@ -68,10 +68,11 @@ struct StageReport {
   int rotationSweepSeeds = 0;
   /// Metal-mask pieces its metal review gave back to the comparison as anatomy (0 without a review or when none).
   int metalPiecesGivenBack = 0;
-  /// Views whose X-ray its haze removal corrected (0 without one), and the largest mean share |s|/I of a view's signal
-  /// its haze term changed.
+  /// Views whose X-ray its haze removal corrected (0 without one), the largest mean share |s|/I of a view's signal
+  /// its haze term changed, and the largest beam hardening it fitted (b (dmax - dmin), XrayHazeCorrector).
   int hazeViewsCorrected = 0;
   double hazeFraction = 0.0;
+  double hazeHardening = 0.0;
   /// Per view its haze removal left as it was: "view 'NAME': why" (the fit failed: a pose far off).
   std::vector<std::string> hazeViewsKept;
   bool cancelled = false;

@@ -181,6 +181,7 @@ Result<HazeRemovalSummary> RegistrationCase::removeHaze(const Eigen::Isometry3d&
     pyramids[v] = std::move(pyramid).value();
     ++summary.viewsCorrected;
     summary.largestHazeFraction = std::max(summary.largestHazeFraction, fit.value().meanHazeFraction);
+    summary.largestHardening = std::max(summary.largestHardening, fit.value().hardening);
   }
   for (std::size_t v = 0; v < m_views.size(); ++v) {
     if (!pyramids[v]) continue;

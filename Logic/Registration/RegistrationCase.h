@@ -65,6 +65,7 @@ struct HazeRemovalSummary {
   int viewsCorrected = 0;                  ///< views whose X-ray was corrected
   int drrs = 0;                            ///< full-resolution DRRs rendered (one per view)
   double largestHazeFraction = 0.0;        ///< the largest mean share of a view's signal the haze term changed
+  double largestHardening = 0.0;           ///< the largest beam hardening b (dmax - dmin) fitted (XrayHazeCorrector)
   std::vector<std::string> viewsKept;      ///< per view left as it was: "view 'NAME': why"
 };
 

@@ -112,6 +112,7 @@ StageReport readStage(const nlohmann::json& object, const std::string& where, co
   if (reader.has("haze_views_corrected")) {
     stage.hazeViewsCorrected = reader.integer("haze_views_corrected", 0);
     stage.hazeFraction = reader.number("haze_fraction");
+    if (reader.has("haze_hardening")) stage.hazeHardening = reader.number("haze_hardening");
   }
   if (const nlohmann::json* kept = reader.has("haze_views_kept")
                                        ? reader.array("haze_views_kept", "a list of texts (one per view)")
@@ -158,6 +159,7 @@ ordered_json RegistrationResultJson::write(const RegistrationResult& result) {
     if (s.hazeViewsCorrected > 0) {
       stages.back()["haze_views_corrected"] = s.hazeViewsCorrected;
       stages.back()["haze_fraction"] = s.hazeFraction;
+      stages.back()["haze_hardening"] = s.hazeHardening;
     }
     if (!s.hazeViewsKept.empty()) stages.back()["haze_views_kept"] = s.hazeViewsKept;
   }

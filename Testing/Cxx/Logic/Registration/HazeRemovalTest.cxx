@@ -114,6 +114,7 @@ TEST(Registration, AStageWithHazeRemovalReportsItAndTheNextRunComparesThePrepare
   const fct::StageReport& last = result.value().stages.back();
   EXPECT_EQ(last.hazeViewsCorrected, 3);
   EXPECT_NE(fct::stageStartNote(last).find("haze removed from 3 views"), std::string::npos) << fct::stageStartNote(last);
+  EXPECT_NE(fct::stageStartNote(last).find("beam hardening up to"), std::string::npos) << fct::stageStartNote(last);
   EXPECT_EQ(result.value().stages.front().hazeViewsCorrected, 0) << "only the stage that asks for it";
   const double error = rc.bone()->meanDistance_mm(result.value().T_world_from_ct, p.simulated.T_truth);
   std::printf("from 5 mm with haze removal: %.3f mm\n", error);

@@ -60,6 +60,7 @@ fct::RegistrationResult fullResult() {
   stage.metalPiecesGivenBack = 3;
   stage.hazeViewsCorrected = 1;
   stage.hazeFraction = 0.125;
+  stage.hazeHardening = 0.375;
   stage.hazeViewsKept = {"view 'lateral': haze removal: the DRR is constant over the valid pixels"};
   r.stages = {stage};
   r.totalSeconds = 7.5;
@@ -155,6 +156,7 @@ TEST(RegistrationResultJson, WriteThenReadGivesTheSameResult) {
   EXPECT_EQ(s.metalPiecesGivenBack, 3);
   EXPECT_EQ(s.hazeViewsCorrected, 1);
   EXPECT_EQ(s.hazeFraction, 0.125);
+  EXPECT_EQ(s.hazeHardening, 0.375);
   EXPECT_EQ(s.hazeViewsKept, a.stages[0].hazeViewsKept);
   EXPECT_FALSE(s.cancelled);
   EXPECT_EQ(b.totalSeconds, 7.5);
