@@ -164,9 +164,8 @@ GlobalFit fitCurve(const GlobalFitSample& sample, double drrRange, bool& atEdge)
 /// s(u).
 struct ViewFit {
   GlobalFit global;
-  cv::Mat drrTerm;  ///< exp(-h(d - dmin)) per pixel, h's argument clamped at 0
-  cv::Mat gain;     ///< g(u)
-  cv::Mat haze;     ///< s(u)
+  cv::Mat gain;  ///< g(u)
+  cv::Mat haze;  ///< s(u)
 };
 
 /// Fits the model over the pixels where `valid` (CV_64F, 0 or 1) is 1. Fails when the DRR does not explain the X-ray
@@ -202,11 +201,10 @@ Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const cv::
   }
 
   // The local fit: Gaussian-weighted moments over the valid pixels.
-  fit.drrTerm = drr.clone();
-  for (auto it = fit.drrTerm.begin<double>(); it != fit.drrTerm.end<double>(); ++it) {
+  cv::Mat drrTerm = drr.clone();  // exp(-h(d - dmin)), h's argument clamped at 0 off the valid pixels
+  for (auto it = drrTerm.begin<double>(); it != drrTerm.end<double>(); ++it) {
     *it = std::exp(-best.curve.apply(std::max(*it - dMin, 0.0)));
   }
-  const cv::Mat& drrTerm = fit.drrTerm;
   // The haze is smooth on the scale of sigma_px: its moments are blurred on a grid `step` times coarser (area
   // averages), with sigma_px / step, and interpolated back.
   const int step = std::max(1, static_cast<int>(sigma_px / kPixelsPerSigma));
