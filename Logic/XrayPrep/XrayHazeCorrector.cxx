@@ -168,23 +168,17 @@ struct ViewFit {
   cv::Mat haze;  ///< s(u)
 };
 
-/// Fits the model over the pixels where `valid` (CV_64F, 0 or 1) is 1. Fails when the DRR does not explain the X-ray
-/// (gain not positive) or the attenuation factor lies at the edge of the searched range.
-Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const cv::Mat& valid, double dMin,
-                        double drrRange, double sigma_px) {
+/// Fits the model over the valid `pixels` (`valid`: the same pixels as a CV_64F image of 0 and 1). Fails when the DRR
+/// does not explain the X-ray (gain not positive) or the attenuation factor lies at the edge of the searched range.
+Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const PixelIndexList& pixels,
+                        const cv::Mat& valid, double dMin, double drrRange, double sigma_px) {
   const int rows = intensity.rows, cols = intensity.cols;
-  std::size_t validCount = 0;
-  for (auto it = valid.begin<double>(); it != valid.end<double>(); ++it) validCount += *it > 0.0 ? 1 : 0;
   // The global fit on an even subsample: the hardening curve, the gain g0 and the haze surface.
-  const std::size_t stride = (validCount + kMaxGlobalFitPixels - 1) / kMaxGlobalFitPixels;
+  const std::size_t stride = (pixels.size() + kMaxGlobalFitPixels - 1) / kMaxGlobalFitPixels;
   GlobalFitSample sample;
-  std::size_t k = 0;
-  for (int r = 0; r < rows; ++r) {
-    for (int col = 0; col < cols; ++col) {
-      if (valid.at<double>(r, col) > 0.0 && k++ % stride == 0) {
-        sample.add(intensity.at<double>(r, col), drr.at<double>(r, col) - dMin, surfaceTerms(col, r, cols, rows));
-      }
-    }
+  for (std::size_t k = 0; k < pixels.size(); k += stride) {
+    const int r = pixels[k] / cols, col = pixels[k] % cols;
+    sample.add(intensity.at<double>(r, col), drr.at<double>(r, col) - dMin, surfaceTerms(col, r, cols, rows));
   }
   bool atEdge = false;
   ViewFit fit;
@@ -221,7 +215,7 @@ Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const cv::
   const cv::Mat sumEE = smooth(drrTerm.mul(drrTerm)), sumEI = smooth(drrTerm.mul(intensity));
   cv::Mat meanE(rows, cols, CV_64F), meanI(rows, cols, CV_64F), varE(rows, cols, CV_64F), covEI(rows, cols, CV_64F);
   std::vector<double> validVariances;
-  validVariances.reserve(validCount);
+  validVariances.reserve(pixels.size());
   for (int r = 0; r < rows; ++r) {
     for (int col = 0; col < cols; ++col) {
       const double w = weight.at<double>(r, col);
@@ -246,8 +240,10 @@ Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const cv::
   fit.haze.create(rows, cols, CV_64F);
   for (int r = 0; r < rows; ++r) {
     for (int col = 0; col < cols; ++col) {
-      double gain = best.gain, haze = best.surface.dot(surfaceTerms(col, r, cols, rows));
-      if (!std::isnan(varE.at<double>(r, col))) {
+      double gain = best.gain, haze = 0.0;
+      if (std::isnan(varE.at<double>(r, col))) {  // no valid pixel within reach: the global fit
+        haze = best.surface.dot(surfaceTerms(col, r, cols, rows));
+      } else {
         gain = (covEI.at<double>(r, col) + ridge * best.gain) / (varE.at<double>(r, col) + ridge);
         gain = std::max(gain, 0.1 * best.gain);  // a gain near 0 would blow the noise up
         haze = meanI.at<double>(r, col) - gain * meanE.at<double>(r, col);
@@ -295,7 +291,7 @@ Result<HazeCorrection> XrayHazeCorrector::correct(const FloatImage& xrayLineInte
   cv::Mat valid(rows, cols, CV_64F, cv::Scalar(0.0));
   for (const std::int32_t i : pixels) valid.at<double>(i / cols, i % cols) = 1.0;
 
-  auto viewFit = fitView(intensityMat, drrMat, valid, dMin, dMax - dMin, sigma_px);
+  auto viewFit = fitView(intensityMat, drrMat, pixels, valid, dMin, dMax - dMin, sigma_px);
   if (!viewFit) return fail(viewFit.error());
   const ViewFit& fit = viewFit.value();
   const GlobalFit& best = fit.global;
