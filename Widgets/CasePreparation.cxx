@@ -44,7 +44,12 @@ CasePreparation::~CasePreparation() {
 
 CasePreparation::Outcome CasePreparation::wait() {
   m_watcher.waitForFinished();
-  return m_watcher.result();
+  Outcome outcome = m_watcher.result();
+  if (m_cancel->load() && outcome.prepared) {  // cancelled after the worker's last step: the request still wins
+    outcome = Outcome{};
+    outcome.error = "the case preparation was cancelled";
+  }
+  return outcome;
 }
 
 }  // namespace fct

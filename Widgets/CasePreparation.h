@@ -37,7 +37,8 @@ class CasePreparation : public QObject {
 
   /// Asks the worker to stop at its next step (it then ends with a "cancelled" error); returns at once.
   void cancel() { m_cancel->store(true); }
-  /// Blocks until the worker is done and returns its outcome (the same one finished() announces).
+  /// Blocks until the worker is done and returns its outcome; after cancel() it is always the "cancelled" error, even
+  /// when the worker had finished its last step before it saw the request.
   Outcome wait();
 
  signals:
