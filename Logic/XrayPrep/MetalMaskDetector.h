@@ -9,8 +9,10 @@
 //   (narrowWindow_mm, a little wider than a wire or a screw shaft); a candidate pixel stands more than minExcess above
 //   both. Bone seen edge-on (the skull's tangent rim, a cortex) can stand as high, but it is one-sided: the
 //   surroundings are the bone on one side and the soft tissue beyond it on the other. The local bone contrast is the
-//   narrow opening minus the erosion over a disc of contrastWindow_mm; a candidate must stand above it by
-//   1 / maxContrastRatio at least;
+//   narrow opening minus the erosion over a disc of contrastWindow_mm; a candidate's bone contrast is at most
+//   maxContrastRatio times its narrow excess. The contrast bounds (maxContrastRatio, seedContrastRatio) are loose
+//   enough for a K-wire crossing the skull base, whose surroundings vary more than the wire stands out; the anatomy
+//   they also let through is the metal review's to give back once a DRR near the pose is at hand (MetalMaskReview);
 // - the candidates' connected pieces are tested as shapes. A piece seeds the metal when it is very dense (mean wide
 //   excess >= veryDenseExcess, length >= minVeryDenseLength_mm); when it is a compact two-sided blob (mean wide excess
 //   >= compactExcess, at least minCompactWidth_mm across its shorter side, mean contrast ratio < compactContrastRatio:
@@ -46,10 +48,10 @@ struct MetalMaskOptions {
   double contrastWindow_mm = 30.0;    ///< diameter of the erosion disc that finds the low side of the surroundings
   double assumedPixelSpacing_mm = 0.4;  ///< pixel spacing used when the image's is unknown
   double minExcess = 1.0;             ///< a candidate stands this far above the wide and the narrow opening
-  double maxContrastRatio = 0.7;      ///< a candidate's bone contrast is below this fraction of its narrow excess
+  double maxContrastRatio = 1.5;      ///< a candidate's bone contrast is below this multiple of its narrow excess
   double maxSagitta_mm = 1.5;         ///< a piece bends at most this much from a straight line
   double minLength_mm = 15.0;         ///< a long piece seeds metal when its mean contrast ratio is below ...
-  double seedContrastRatio = 0.5;     ///< ... this
+  double seedContrastRatio = 0.8;     ///< ... this
   double minClippedLength_mm = 4.0;   ///< the length that counts as long for a piece reaching the valid pixels' edge
   double denseExcess = 2.3;           ///< a piece with this mean wide excess seeds metal when ...
   double minDenseLength_mm = 10.0;    ///< ... at least this long and ...

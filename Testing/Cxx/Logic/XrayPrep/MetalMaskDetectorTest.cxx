@@ -1,7 +1,8 @@
 // MetalMaskDetector: a dark (high line integral) thin bar is masked with its dilation, smooth bone and its edges are
 // not, nor a skull-like rim as dense as the bar, invalid pixels stay invalid and are not counted, a clean image loses
 // nothing, a short wire stub is metal only where the field's edge cuts it, a screw seen nearly end-on is found and a
-// dense spot near a bone edge is not, a wire crossing a screw is still found, and bad input fails.
+// dense spot near a bone edge is not, a wire crossing a screw is still found, a wire crossing high-contrast bone is
+// found, and bad input fails.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -169,4 +170,33 @@ TEST(MetalMaskDetector, WireCrossingAScrewIsStillFoundAsAStraightBar) {
   EXPECT_FALSE(metal.value().mask.isValid(60, 40)) << "the wire";
   EXPECT_FALSE(metal.value().mask.isValid(160, 45)) << "the screw where the wire meets it";
   EXPECT_TRUE(metal.value().mask.isValid(60, 150)) << "soft tissue";
+}
+
+TEST(MetalMaskDetector, WireCrossingHighContrastBoneIsMetal) {
+  // At 0.4 mm pixels a 60 mm steel wire (adding 1.6) crosses a 40 mm slab of dense bone (adding 2.0 over soft tissue),
+  // as a K-wire crosses the skull base in a lateral view: within 15 mm of the slab's edges the bone's own contrast is
+  // 1.25 times the wire's excess. The wire is metal along its whole length, the slab's edges are not. A detector that
+  // takes only candidates with less bone contrast than 0.7 times their excess cuts the wire into short pieces and
+  // finds none of it.
+  fct::FloatImage image = fct::FloatImage::filled(240, 200, 1.0f);
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) {
+      image.at(col, row) += static_cast<float>(2.0 / (1.0 + std::exp((70.0 - col) / 1.0)) /
+                                               (1.0 + std::exp((col - 170.0) / 1.0)));
+    }
+  }
+  addBar(image, 45.0, 100.0, 195.0, 100.0, 1.0, 1.6f);
+  const fct::ValidMask field = fct::ValidMask::allValid(240, 200);
+  const auto metal = fct::MetalMaskDetector().detect(image, field, 0.4);
+  ASSERT_TRUE(metal.ok()) << metal.error();
+  for (int col : {50, 80, 120, 160, 190}) {
+    EXPECT_FALSE(metal.value().mask.isValid(col, 100)) << "wire at column " << col;
+  }
+  EXPECT_TRUE(metal.value().mask.isValid(70, 30)) << "the slab's edge";
+  EXPECT_TRUE(metal.value().mask.isValid(120, 30)) << "the slab";
+  fct::MetalMaskOptions tight;
+  tight.maxContrastRatio = 0.7;
+  const auto tightMetal = fct::MetalMaskDetector(tight).detect(image, field, 0.4);
+  ASSERT_TRUE(tightMetal.ok()) << tightMetal.error();
+  EXPECT_EQ(tightMetal.value().metalPixelCount, 0u);
 }
