@@ -47,7 +47,7 @@ CasePreparation::Outcome CasePreparation::wait() {
   Outcome outcome = m_watcher.result();
   if (m_cancel->load() && outcome.prepared) {  // cancelled after the worker's last step: the request still wins
     outcome = Outcome{};
-    outcome.error = "the case preparation was cancelled";
+    outcome.error = RegistrationCase::kCancelledError;
   }
   return outcome;
 }

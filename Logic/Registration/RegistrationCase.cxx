@@ -34,7 +34,6 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   // One report per step (the CT, each view, the bone surface); a cancel between steps stops the preparation.
   const double steps = static_cast<double>(views.size() + 2);
   const auto cancelled = [&] { return monitor.cancelled(); };
-  const char* const kCancelled = "the case preparation was cancelled";
   monitor.report("CT", 0.0, "preparing the CT for DRRs");
 
   auto drrVolume = DrrVolume::create(ct);
@@ -56,7 +55,7 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
 
   for (std::size_t v = 0; v < views.size(); ++v) {
     const RegistrationView& view = views[v];
-    if (cancelled()) return fail(kCancelled);
+    if (cancelled()) return fail(kCancelledError);
     monitor.report("views", static_cast<double>(v + 1) / steps, fmt::format("preparing the X-ray of view '{}'", view.name));
     XrayPreparationOptions preparation = options.preparation;
     preparation.spheres.insert(preparation.spheres.end(), view.spheres.begin(), view.spheres.end());
@@ -67,7 +66,7 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
              result.m_renderer, nullptr});
   }
 
-  if (cancelled()) return fail(kCancelled);
+  if (cancelled()) return fail(kCancelledError);
   monitor.report("bone", static_cast<double>(views.size() + 1) / steps, "extracting the bone surface");
   auto bone = BoneSurface::extract(ct, options.boneThreshold_hu);
   if (bone) {

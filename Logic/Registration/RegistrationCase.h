@@ -72,6 +72,9 @@ struct HazeRemovalSummary {
 /// A prepared registration problem: CT, renderer and views.
 class RegistrationCase {
  public:
+  /// The error of a preparation that was cancelled (create() with a cancelling monitor, and the Studio's preparation).
+  static constexpr const char* kCancelledError = "the case preparation was cancelled";
+
   /// Prepares the CT and every view, and for the transgraph method with an expected pose each view's table (the
   /// monitor gets one report per step, CT, each view, bone surface, and the table builds, and can cancel between
   /// steps: the error then says the preparation was cancelled). Fails, naming the view, on no view, a camera whose detector differs

@@ -160,7 +160,7 @@ GlobalFit fitCurve(const GlobalFitSample& sample, double drrRange, bool& atEdge)
   return best;
 }
 
-/// The fit over the pixels where `valid` is 1: the global curve and gain, and per pixel the local gain g(u) and haze
+/// The fit over the valid pixels: the global curve and gain, and per pixel the local gain g(u) and haze
 /// s(u).
 struct ViewFit {
   GlobalFit global;
@@ -168,11 +168,13 @@ struct ViewFit {
   cv::Mat haze;  ///< s(u)
 };
 
-/// Fits the model over the valid `pixels` (`valid`: the same pixels as a CV_64F image of 0 and 1). Fails when the DRR
-/// does not explain the X-ray (gain not positive) or the attenuation factor lies at the edge of the searched range.
-Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const PixelIndexList& pixels,
-                        const cv::Mat& valid, double dMin, double drrRange, double sigma_px) {
+/// Fits the model over the valid `pixels` (raster indices). Fails when the DRR does not explain the X-ray (gain not
+/// positive) or the attenuation factor lies at the edge of the searched range.
+Result<ViewFit> fitView(const cv::Mat& intensity, const cv::Mat& drr, const PixelIndexList& pixels, double dMin,
+                        double drrRange, double sigma_px) {
   const int rows = intensity.rows, cols = intensity.cols;
+  cv::Mat valid(rows, cols, CV_64F, cv::Scalar(0.0));  // the valid pixels as weights of 1
+  for (const std::int32_t i : pixels) valid.at<double>(i / cols, i % cols) = 1.0;
   // The global fit on an even subsample: the hardening curve, the gain g0 and the haze surface.
   const std::size_t stride = (pixels.size() + kMaxGlobalFitPixels - 1) / kMaxGlobalFitPixels;
   GlobalFitSample sample;
@@ -288,10 +290,7 @@ Result<HazeCorrection> XrayHazeCorrector::correct(const FloatImage& xrayLineInte
   cv::Mat intensityMat;
   cv::exp(-toMat(xrayLineIntegrals), intensityMat);
   const cv::Mat drrMat = toMat(drrLineIntegrals);
-  cv::Mat valid(rows, cols, CV_64F, cv::Scalar(0.0));
-  for (const std::int32_t i : pixels) valid.at<double>(i / cols, i % cols) = 1.0;
-
-  auto viewFit = fitView(intensityMat, drrMat, pixels, valid, dMin, dMax - dMin, sigma_px);
+  auto viewFit = fitView(intensityMat, drrMat, pixels, dMin, dMax - dMin, sigma_px);
   if (!viewFit) return fail(viewFit.error());
   const ViewFit& fit = viewFit.value();
   const GlobalFit& best = fit.global;

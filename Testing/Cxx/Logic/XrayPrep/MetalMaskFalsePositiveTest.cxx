@@ -23,6 +23,7 @@
 #include "Drr/CutFaceRayMask.h"
 #include "Drr/DrrVolume.h"
 #include "Drr/SiddonRayCaster.h"
+#include "Evaluation/PoseOffset.h"
 #include "Evaluation/StudyRunner.h"
 #include "IO/Volume/CtLoader.h"
 #include "Image/BoneSurface.h"
@@ -46,22 +47,6 @@ struct ViewMeasure {
   double coverage = 0.0;       ///< fraction of the tool pixels masked in the view with tools (1 without tools)
   std::size_t toolPixels = 0;  ///< valid pixels the tools raise by more than 0.5
 };
-
-/// The pose the metal review sees in a registration: the truth moved by about what the first stage leaves (0.5 mm along
-/// each axis, 0.3 deg about each axis through the CT's centre).
-Eigen::Isometry3d reviewPose(const Eigen::Isometry3d& T_truth, const fct::Volume& ct) {
-  const Eigen::Vector3d centre_ct_mm = ct.centre_lps_mm();
-  const Eigen::Vector3d centre_world_mm = T_truth * centre_ct_mm;
-  const double angle_rad = 0.3 * std::acos(-1.0) / 180.0;
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitZ()))
-                                .toRotationMatrix();
-  Eigen::Isometry3d T_move = Eigen::Isometry3d::Identity();
-  T_move.linear() = R;
-  T_move.translation() = centre_world_mm - R * centre_world_mm + Eigen::Vector3d(0.5, 0.5, 0.5);
-  return T_move * T_truth;
-}
 
 /// The level-0 line integrals and valid mask of a simulated view, prepared without the metal exclusion.
 struct Prepared {
@@ -102,7 +87,8 @@ std::vector<fct::FloatImage> renderViews(const fct::Volume& ct, const std::vecto
 /// seed), on the 5 standard views of a cols x rows detector of `spacing_mm` pixels; one table line printed per view.
 std::vector<ViewMeasure> measureViews(const fct::Volume& ct, const std::string& label, int cols, int rows,
                                       double spacing_mm, bool coverage) {
-  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(fct::BoneSurface::extract(ct).value());
+  const fct::BoneSurface bone = fct::BoneSurface::extract(ct).value();
+  const Eigen::Isometry3d T_truth = fct::StudyRunner::truthPose(bone);
   fct::StandardViewOptions viewOptions;
   viewOptions.count = 5;
   viewOptions.cols = cols;
@@ -120,7 +106,9 @@ std::vector<ViewMeasure> measureViews(const fct::Volume& ct, const std::string& 
   const auto cutFaces = fct::CutFaceRayMask::create(*drrVolume, 5.0);
   EXPECT_TRUE(cutFaces.ok()) << cutFaces.error();
   if (!cutFaces) return {};
-  const Eigen::Isometry3d T_review = reviewPose(T_truth, ct);
+  // The pose the review sees in a registration: the truth moved by about what the first stage leaves.
+  const Eigen::Isometry3d T_review = fct::PoseOffset::apply(
+      bone, T_truth, fct::PoseParameters{Eigen::Vector3d::Constant(0.3), Eigen::Vector3d::Constant(0.5)});
   std::vector<ViewMeasure> measures;
   for (std::size_t v = 0; v < views.size(); ++v) {
     ViewMeasure measure{views[v].name, 0.0, 0.0, 0.0, 1.0, 0};
