@@ -196,18 +196,32 @@ nlohmann::ordered_json transgraphReport(const RegistrationCase& c) {
   return report;
 }
 
-/// Each view's fraction of the field excluded as metal, for RESULT.json; printed unless --no-metal-mask, each line
-/// ending with `when` (e.g. " after the metal review").
-nlohmann::ordered_json metalReport(const Options& o, const RegistrationCase& c, const std::string& when = {}) {
+/// Each view's fraction of the field excluded as metal, and with --cut-face-margin-mm the fraction of the field whose
+/// rays clear the CT's cut faces at `T_world_from_ct` (what the mask takes from the comparison), as the RESULT.json
+/// members "metal_fraction" and "metal_fraction_covered"; printed unless --no-metal-mask, each line ending with `when`
+/// (e.g. " after the metal review"). Fails on a bad view (not expected: the case's own).
+Result<nlohmann::ordered_json> metalReport(const Options& o, const RegistrationCase& c,
+                                           const Eigen::Isometry3d& T_world_from_ct, const std::string& when = {}) {
   nlohmann::ordered_json fractions = nlohmann::ordered_json::object();
+  nlohmann::ordered_json covered = nlohmann::ordered_json::object();
+  const bool cutFaces = o.cutFaceMargin_mm >= 0.0;
   for (std::size_t v = 0; v < c.viewCount(); ++v) {
     fractions[c.viewName(v)] = c.prepared(v).metalFraction;
+    std::string coveredText;
+    if (cutFaces) {
+      auto fraction = c.metalFractionOfCoveredField(v, T_world_from_ct);
+      if (!fraction) return fail(fmt::format("view {}: {}", c.viewName(v), fraction.error()));
+      covered[c.viewName(v)] = fraction.value();
+      coveredText = fmt::format(" ({:.2f} % of the field whose rays clear the CT's cut faces)", 100.0 * fraction.value());
+    }
     if (!o.noMetalMask) {
-      fmt::print("view {}: metal mask excludes {:.2f} % of the field{}\n", c.viewName(v),
-                 100.0 * c.prepared(v).metalFraction, when);
+      fmt::print("view {}: metal mask excludes {:.2f} % of the field{}{}\n", c.viewName(v),
+                 100.0 * c.prepared(v).metalFraction, coveredText, when);
     }
   }
-  return fractions;
+  nlohmann::ordered_json report{{"metal_fraction", std::move(fractions)}};
+  if (cutFaces) report["metal_fraction_covered"] = std::move(covered);
+  return report;
 }
 
 /// --masks: each view's full-resolution validity mask as <view>_mask.png.
@@ -292,7 +306,9 @@ nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r,
   for (const auto& item : json["options"].items()) options[item.key()] = item.value();
   json["options"] = std::move(options);
   json["transgraph"] = std::move(transgraph);
-  if (!o.noMetalMask) json["metal_fraction"] = std::move(metal);
+  if (!o.noMetalMask) {
+    for (auto& item : metal.items()) json[item.key()] = std::move(item.value());
+  }
   if (error) {
     json["error_vs_truth"] = {{"initial_mean_surface_mm", error->initialMean_mm},
                               {"final_mean_surface_mm", error->finalMean_mm},
@@ -405,7 +421,8 @@ int runRegister(const Options& o) {
   auto registrationCase = prepareCase(o, in, caseOptions, InterruptGuard::cancelFlag());
   if (!registrationCase) return reportError(registrationCase.error());
   nlohmann::ordered_json transgraph = transgraphReport(registrationCase.value());
-  nlohmann::ordered_json metal = metalReport(o, registrationCase.value());
+  auto metal = metalReport(o, registrationCase.value(), in.initial.T_world_from_ct);
+  if (!metal) return reportError(metal.error());
   if (Status written = writeMasks(o, registrationCase.value()); !written) return reportError(written.error());
 
   link.value().connectEarly();
@@ -414,8 +431,14 @@ int runRegister(const Options& o) {
   auto result = runRegistration(o, in, registrationCase.value(), InterruptGuard::cancelFlag(), onStageEnd);
   if (!result) return reportError(result.error());
   const RegistrationResult& r = result.value();
-  if (std::any_of(r.stages.begin(), r.stages.end(), [](const StageReport& s) { return s.metalPiecesGivenBack > 0; })) {
-    metal = metalReport(o, registrationCase.value(), " after the metal review");
+  const bool reviewed =
+      std::any_of(r.stages.begin(), r.stages.end(), [](const StageReport& s) { return s.metalPiecesGivenBack > 0; });
+  if (reviewed || o.cutFaceMargin_mm >= 0.0) {  // the mask, or the rays the CT covers, changed since the first report
+    metal = metalReport(o, registrationCase.value(), r.T_world_from_ct,
+                        reviewed ? " after the metal review" : " at the final pose");
+    if (!metal) return reportError(metal.error());
+  }
+  if (reviewed) {
     if (Status written = writeMasks(o, registrationCase.value()); !written) return reportError(written.error());
   }
   if (Status written = writeOverlays(o, in, caseOptions.boneThreshold_hu, r); !written) {
@@ -423,7 +446,7 @@ int runRegister(const Options& o) {
   }
   const std::optional<TruthError> error = truthError(in, registrationCase.value(), r);
   const Status written =
-      writeResults(o, r, resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal), error));
+      writeResults(o, r, resultJson(o, r, in.initial.source, std::move(transgraph), std::move(metal).value(), error));
   if (!written) return reportError(written.error());
   if (!o.dicomReg.empty()) {
     auto registration = RegistrationDicomExport::write(in.ct, in.views, r, o.dicomReg);

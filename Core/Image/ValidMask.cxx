@@ -64,6 +64,22 @@ Status ValidMask::intersect(const ValidMask& other) {
   return Ok{};
 }
 
+Result<double> ValidMask::excludedFractionWithin(const ValidMask& kept, const ValidMask& region) const {
+  for (const ValidMask* other : {&kept, &region}) {
+    if (other->cols != cols || other->rows != rows) {
+      return fail(fmt::format("cannot count a {}x{} mask's pixels in a {}x{} mask; both must match the image size",
+                              other->cols, other->rows, cols, rows));
+    }
+  }
+  std::size_t inRegion = 0, excluded = 0;
+  for (std::size_t i = 0; i < valid.size(); ++i) {
+    if (valid[i] == 0 || region.valid[i] == 0) continue;
+    ++inRegion;
+    if (kept.valid[i] == 0) ++excluded;
+  }
+  return inRegion == 0 ? 0.0 : static_cast<double>(excluded) / static_cast<double>(inRegion);
+}
+
 std::size_t ValidMask::validCount() const {
   return static_cast<std::size_t>(std::count_if(valid.begin(), valid.end(), [](std::uint8_t v) { return v != 0; }));
 }

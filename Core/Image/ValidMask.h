@@ -35,6 +35,9 @@ struct ValidMask {
   Status intersect(const ValidMask& other);
   /// Number of valid pixels.
   std::size_t validCount() const;
+  /// Of the pixels valid here and in `region`, the fraction that `kept` excludes (e.g. of an X-ray's field, on the rays
+  /// a CT covers, the share a metal mask takes out); 0 when no pixel is valid in both. Fails when the sizes differ.
+  Result<double> excludedFractionWithin(const ValidMask& kept, const ValidMask& region) const;
   /// Linear indices (row * cols + col) of the valid pixels, in raster order.
   PixelIndexList pixelList() const;
 };

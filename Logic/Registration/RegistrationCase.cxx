@@ -345,6 +345,14 @@ Result<RoiSelection> RegistrationCase::allWindows(std::size_t v, int level, int 
   return selector.value()->selectAll();
 }
 
+Result<double> RegistrationCase::metalFractionOfCoveredField(std::size_t v,
+                                                             const Eigen::Isometry3d& T_world_from_ct) const {
+  auto covered = cutFaceMask(v, 0, T_world_from_ct);
+  if (!covered) return fail(covered.error());
+  const PreparedXray& prepared = m_views[v].prepared;
+  return prepared.fieldMask.excludedFractionWithin(prepared.pyramid.level(0).mask, covered.value());
+}
+
 Result<ValidMask> RegistrationCase::cutFaceMask(std::size_t v, int level,
                                                 const Eigen::Isometry3d& T_world_from_ct) const {
   if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());

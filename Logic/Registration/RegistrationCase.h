@@ -181,6 +181,12 @@ class RegistrationCase {
   /// pixel valid when the margin is negative (off). Fails on a bad view or level, or a view without a level camera.
   Result<ValidMask> cutFaceMask(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct) const;
 
+  /// The fraction of view v's field pixels (level 0, before the metal exclusion) whose rays clear the CT's cut faces
+  /// with the CT at `T_world_from_ct` (LPS mm; the case's margin, every field pixel when it is off) that the metal mask
+  /// excludes: what the mask takes from the pixels a comparison can use. 0 when no field pixel clears the cut faces.
+  /// Fails on a bad view.
+  Result<double> metalFractionOfCoveredField(std::size_t v, const Eigen::Isometry3d& T_world_from_ct) const;
+
   /// Checks that the CT at `T_world_from_ct` projects onto the valid pixels of every view at `level`: fails, naming
   /// the view, when the DRR is empty (zero) over all of them, i.e. the DRR and the X-ray do not overlap.
   Status checkOverlap(const Eigen::Isometry3d& T_world_from_ct, int level) const;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "Registration/Registration.h"
@@ -55,16 +56,20 @@ struct KWireCase {
   fct::RegistrationCase registrationCase;
 };
 
-KWireCase prepareKWireCase(bool excludeMetal) {
+/// The phantom case with `wires` (world segments, mm) burnt into its views; `cutFaceMargin_mm` as the case option.
+KWireCase prepareKWireCase(bool excludeMetal,
+                           const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& wires = kWires(),
+                           double cutFaceMargin_mm = -1.0) {
   fct::PhantomOptions phantom;
   phantom.dims = Eigen::Vector3i(80, 80, 60);
   phantom.spacing_mm = 2.0;
   auto simulated = fct::test::simulateCase(fct::PhantomBuilder::build(phantom).value());
   EXPECT_TRUE(simulated.ok()) << simulated.error();
   fct::test::KnownTruthCase c = std::move(simulated).value();
-  addKWires(c, kWires());
+  addKWires(c, wires);
   fct::RegistrationCaseOptions caseOptions;
   caseOptions.preparation.excludeMetal = excludeMetal;
+  caseOptions.cutFaceMargin_mm = cutFaceMargin_mm;
   auto registrationCase = fct::RegistrationCase::create(c.ct, c.views, caseOptions);
   EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
   return KWireCase{std::move(c), std::move(registrationCase).value()};
@@ -163,4 +168,45 @@ TEST(MetalRegistration, MetalReviewComparesMetalTheCtHolds) {
                 100.0 * rodsBefore[v], 100.0 * after);
     EXPECT_LT(after, 0.25 * rodsBefore[v]) << withRods.value().viewName(v);
   }
+}
+
+TEST(MetalRegistration, MetalFractionOfCoveredFieldCountsOnlyRaysTheCtCovers) {
+  // The two K-wires through the bone: on rays the CT covers.
+  KWireCase through = prepareKWireCase(true, kWires(), 5.0);
+  // A K-wire beyond the phantom's superior face (world z, LPS): the detector masks it, but its rays do not cross the
+  // CT, so it takes nothing from the pixels a comparison uses (the phantom's own false positives, in the case without
+  // a wire, stay as they are).
+  KWireCase noWire = prepareKWireCase(true, {}, 5.0);
+  const fct::Volume& ct = through.truth.ct;
+  double top_world_mm = -1e9;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d ijk((corner & 1) ? ct.dims().x() - 1 : 0, (corner & 2) ? ct.dims().y() - 1 : 0,
+                              (corner & 4) ? ct.dims().z() - 1 : 0);
+    top_world_mm = std::max(top_world_mm, (through.truth.T_truth * ct.lpsFromIjk(ijk)).z());
+  }
+  std::printf("the CT's highest corner at world z %.1f mm\n", top_world_mm);
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> beyondTheSlab = {
+      {Eigen::Vector3d(-30.0, -20.0, top_world_mm + 15.0), Eigen::Vector3d(30.0, 20.0, top_world_mm + 25.0)}};
+  KWireCase beyond = prepareKWireCase(true, beyondTheSlab, 5.0);
+  KWireCase throughNoMargin = prepareKWireCase(true, kWires(), -1.0);
+  for (std::size_t v = 0; v < beyond.registrationCase.viewCount(); ++v) {
+    const std::string name = beyond.registrationCase.viewName(v);
+    const double beyondField = beyond.registrationCase.prepared(v).metalFraction;
+    const double noWireField = noWire.registrationCase.prepared(v).metalFraction;
+    auto beyondCovered = beyond.registrationCase.metalFractionOfCoveredField(v, beyond.truth.T_truth);
+    auto noWireCovered = noWire.registrationCase.metalFractionOfCoveredField(v, noWire.truth.T_truth);
+    auto throughCovered = through.registrationCase.metalFractionOfCoveredField(v, through.truth.T_truth);
+    auto noMargin = throughNoMargin.registrationCase.metalFractionOfCoveredField(v, throughNoMargin.truth.T_truth);
+    ASSERT_TRUE(beyondCovered.ok() && noWireCovered.ok() && throughCovered.ok() && noMargin.ok()) << name;
+    std::printf("view %s: no wire %.2f %% of the field, %.2f %% of the covered field; wire beyond the slab %.2f %%, "
+                "%.2f %%; wires through the bone %.2f %% of the covered field\n",
+                name.c_str(), 100.0 * noWireField, 100.0 * noWireCovered.value(), 100.0 * beyondField,
+                100.0 * beyondCovered.value(), 100.0 * throughCovered.value());
+    EXPECT_GT(beyondField, noWireField + 0.002) << name << ": the wire beyond the slab is masked";
+    EXPECT_DOUBLE_EQ(beyondCovered.value(), noWireCovered.value()) << name;
+    EXPECT_GT(throughCovered.value(), noWireCovered.value() + 0.005) << name;
+    // Without a cut-face margin every field pixel counts: the whole field's fraction.
+    EXPECT_DOUBLE_EQ(noMargin.value(), throughNoMargin.registrationCase.prepared(v).metalFraction) << name;
+  }
+  EXPECT_FALSE(beyond.registrationCase.metalFractionOfCoveredField(99, beyond.truth.T_truth).ok());
 }

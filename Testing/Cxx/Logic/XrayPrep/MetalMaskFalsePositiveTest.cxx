@@ -127,14 +127,10 @@ std::vector<ViewMeasure> measureViews(const fct::Volume& ct, const std::string& 
     EXPECT_TRUE(reviewed.ok()) << reviewed.error();
     if (!reviewed) return measures;
     measure.reviewedFalsePositive = static_cast<double>(reviewed.value().metalPixelCount) / validCount;
-    std::size_t coveredCount = 0, coveredMetal = 0;
-    for (std::size_t i = 0; i < covered.valid.size(); ++i) {
-      if (!metalFree.mask.valid[i] || !covered.valid[i]) continue;
-      ++coveredCount;
-      if (!reviewed.value().mask.valid[i]) ++coveredMetal;
-    }
-    measure.comparedFalsePositive =
-        static_cast<double>(coveredMetal) / static_cast<double>(std::max<std::size_t>(1, coveredCount));
+    const auto compared = metalFree.mask.excludedFractionWithin(reviewed.value().mask, covered);
+    EXPECT_TRUE(compared.ok()) << compared.error();
+    if (!compared) return measures;
+    measure.comparedFalsePositive = compared.value();
     if (coverage) {
       const Prepared withTools = prepare(toolImages[v], cameras[v]);
       const auto toolMask = detector.detect(withTools.lineIntegrals, withTools.mask, spacing_mm);
