@@ -212,7 +212,8 @@ Result<nlohmann::ordered_json> metalReport(const Options& o, const RegistrationC
       auto fraction = c.metalFractionOfCoveredField(v, T_world_from_ct);
       if (!fraction) return fail(fmt::format("view {}: {}", c.viewName(v), fraction.error()));
       covered[c.viewName(v)] = fraction.value();
-      coveredText = fmt::format(" ({:.2f} % of the field whose rays clear the CT's cut faces)", 100.0 * fraction.value());
+      coveredText =
+          fmt::format(" ({:.2f} % of the field whose rays clear the CT's cut faces)", 100.0 * fraction.value());
     }
     if (!o.noMetalMask) {
       fmt::print("view {}: metal mask excludes {:.2f} % of the field{}{}\n", c.viewName(v),
