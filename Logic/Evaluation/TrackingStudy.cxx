@@ -170,7 +170,7 @@ Result<std::vector<TrackingFrameRecord>> runSequence(const TrackingStudyDefiniti
     firstViews.push_back(RegistrationView{views.value()[v].name, images[0][v], views.value()[v].camera, {}});
   }
   RegistrationCaseOptions caseOptions;
-  caseOptions.cutFaceMargin_mm = 5.0;  // the simulated patient continues beyond the CT's end faces
+  caseOptions.cutFaceMargin_mm = StudyRunner::kCutFaceMargin_mm;  // the simulated patient continues beyond the CT
   auto registrationCase = RegistrationCase::create(*scene.ct, firstViews, caseOptions);
   if (!registrationCase) return fail(fmt::format("condition '{}': {}", c.name, registrationCase.error()));
   auto tracker = CineTracker::create(registrationCase.value(), trackerOptions);

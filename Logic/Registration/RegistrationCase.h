@@ -44,11 +44,13 @@ struct RegistrationCaseOptions {
   DrrRendererOptions drr;                  ///< DRR method ("siddon", "raycast", ...)
   XrayPreparationOptions preparation;      ///< masks, intensity model, pyramid levels (spheres come per view)
   double boneThreshold_hu = 250.0;         ///< iso-value of the bone surface giving the rotation centre and radius
+  /// The cut-face margin of a case unless told otherwise, and of every evaluation study (mm).
+  static constexpr double kDefaultCutFaceMargin_mm = 5.0;
   /// Pixels whose rays cross the patient beyond the CT's end faces along its slice axis, or pass within this many mm
   /// of them, at the initial pose, are left out of the comparison (CutFaceRayMask): the X-ray shows anatomy there
-  /// that the CT lacks. Negative: off (the default: the mask is made at the initial pose, so it is only as right as
-  /// that pose; the evaluation studies use 5 mm).
-  double cutFaceMargin_mm = -1.0;
+  /// that the CT lacks. Negative: off. The mask is made at the initial pose (and again at a stage's start when the
+  /// bone moved more than 5 mm from it), so it is as right as that pose; a face with no tissue cuts nothing.
+  double cutFaceMargin_mm = kDefaultCutFaceMargin_mm;
   /// Transgraph method: the pose (CT mm -> world mm, LPS) around which each view's table is built, e.g. the initial
   /// pose from landmarks. nullopt: the tables are built at the initial pose of the first Registration::run.
   std::optional<Eigen::Isometry3d> T_expected_world_from_ct;

@@ -72,7 +72,16 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
     EXPECT_TRUE(fs::exists(dir / "masks" / (std::string(view) + "_mask.png"))) << view;
     EXPECT_LT(json["metal_fraction"][view].get<double>(), 0.05) << "the phantom has no metal: " << view;
   }
-  EXPECT_FALSE(json.contains("metal_fraction_covered")) << "no cut-face margin, no covered field";
+  // The default cut-face margin (5 mm): each view's metal share of the field whose rays clear the CT's cut faces.
+  EXPECT_EQ(json["options"]["cut_face_margin_mm"].get<double>(), 5.0);
+  EXPECT_NE(run.out.find("of the field whose rays clear the CT's cut faces) at the final pose"), std::string::npos)
+      << run.out;
+  for (const char* view : {"ap", "lateral", "oblique45"}) {
+    ASSERT_TRUE(json["metal_fraction_covered"].contains(view)) << view;
+    const double covered = json["metal_fraction_covered"][view].get<double>();
+    EXPECT_GE(covered, 0.0) << view;
+    EXPECT_LT(covered, 0.05) << "the phantom has no metal: " << view;
+  }
 }
 
 TEST(RegisterCommand, ResultFileReadsBackAsARegistrationResult) {
@@ -80,22 +89,14 @@ TEST(RegisterCommand, ResultFileReadsBackAsARegistrationResult) {
   const Eigen::Isometry3d truth = makeCase(dir);
   ASSERT_TRUE(fct::PoseFile::write(perturbed(truth), dir / "init.json").ok());
   const auto run = fct::test::runCli(fmt::format("register --ct '{}' --views '{}' --init '{}' --preset fast --local-only "
-                                                 "--cut-face-margin-mm 5 --out '{}'",
+                                                 "--cut-face-margin-mm -1 --out '{}'",
                                                  (dir / "ct.nrrd").string(), (dir / "sim" / "views.json").string(),
                                                  (dir / "init.json").string(), (dir / "result.json").string()));
   ASSERT_EQ(run.exitCode, 0) << run.err;
   auto json = fct::JsonDocument::parse(dir / "result.json");
   ASSERT_TRUE(json.ok()) << json.error();
   EXPECT_EQ(json.value()["format"], fct::RegistrationResultJson::kFormat);
-  // With a cut-face margin: each view's metal share of the field whose rays clear the CT's cut faces, printed too.
-  EXPECT_NE(run.out.find("of the field whose rays clear the CT's cut faces) at the final pose"), std::string::npos)
-      << run.out;
-  for (const char* view : {"ap", "lateral", "oblique45"}) {
-    ASSERT_TRUE(json.value()["metal_fraction_covered"].contains(view)) << view;
-    const double covered = json.value()["metal_fraction_covered"][view].get<double>();
-    EXPECT_GE(covered, 0.0) << view;
-    EXPECT_LT(covered, 0.05) << "the phantom has no metal: " << view;
-  }
+  EXPECT_FALSE(json.value().contains("metal_fraction_covered")) << "no cut-face margin, no covered field";
   auto result = fct::RegistrationResultJson::read(json.value(), "result.json");
   ASSERT_TRUE(result.ok()) << result.error();
   EXPECT_TRUE(result.value().T_initial.isApprox(perturbed(truth), 1e-12));

@@ -32,7 +32,9 @@ fct::test::PreparedCase hazyPhantom(double fraction) {
   auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), options);
   EXPECT_TRUE(simulated.ok()) << simulated.error();
   addHaze(simulated.value(), options.referenceIntensity, fraction);
-  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, {});
+  fct::RegistrationCaseOptions caseOptions;
+  caseOptions.cutFaceMargin_mm = -1.0;  // the X-rays are DRRs of this CT alone: no anatomy beyond its end faces
+  auto registrationCase = fct::RegistrationCase::create(simulated.value().ct, simulated.value().views, caseOptions);
   EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
   return fct::test::PreparedCase{std::move(simulated).value(), std::move(registrationCase).value()};
 }

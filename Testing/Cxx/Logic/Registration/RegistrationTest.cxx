@@ -441,7 +441,9 @@ TEST(Registration, OneViewLocalSearchWithADepthScaleMovesTheDepthThatEqualUnitsL
   geometry.sourceToDetector_mm = 1500.0;
   auto simulated = fct::test::simulateCase(fct::test::smallPhantom(), geometry);
   ASSERT_TRUE(simulated.ok()) << simulated.error();
-  auto oneView = fct::RegistrationCase::create(simulated.value().ct, {simulated.value().views[0]});
+  fct::RegistrationCaseOptions caseOptions;
+  caseOptions.cutFaceMargin_mm = -1.0;  // the X-ray is a DRR of this CT alone: no anatomy beyond its end faces
+  auto oneView = fct::RegistrationCase::create(simulated.value().ct, {simulated.value().views[0]}, caseOptions);
   ASSERT_TRUE(oneView.ok()) << oneView.error();
   fct::RegistrationCase& rc = oneView.value();
   const Eigen::Isometry3d& T_truth = simulated.value().T_truth;
