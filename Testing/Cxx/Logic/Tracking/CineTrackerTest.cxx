@@ -30,7 +30,9 @@ Tracked prepare(int frames, int viewCount = 2, int size_px = 128, double pixelSp
   options.pixelSpacing_mm = pixelSpacing_mm;
   auto sequence = fct::test::simulateSequence(ct, options);
   EXPECT_TRUE(sequence.ok()) << sequence.error();
-  auto registrationCase = fct::RegistrationCase::create(ct, sequence.value().views);
+  fct::RegistrationCaseOptions caseOptions;
+  caseOptions.cutFaceMargin_mm = -1.0;  // the frames are DRRs of this CT alone: no anatomy beyond its end faces
+  auto registrationCase = fct::RegistrationCase::create(ct, sequence.value().views, caseOptions);
   EXPECT_TRUE(registrationCase.ok()) << registrationCase.error();
   return Tracked{std::move(ct), std::move(sequence).value(), std::move(registrationCase).value()};
 }
