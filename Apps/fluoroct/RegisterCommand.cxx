@@ -196,12 +196,14 @@ nlohmann::ordered_json transgraphReport(const RegistrationCase& c) {
   return report;
 }
 
-/// Each view's fraction of the field excluded as metal, and with --cut-face-margin-mm the fraction of the field whose
-/// rays clear the CT's cut faces at `T_world_from_ct` (what the mask takes from the comparison), as the RESULT.json
-/// members "metal_fraction" and "metal_fraction_covered"; printed unless --no-metal-mask, each line ending with `when`
-/// (e.g. " after the metal review"). Fails on a bad view (not expected: the case's own).
+/// The RESULT.json members of the metal mask, printed a line per view ending with `when` (e.g. " after the metal
+/// review"): each view's fraction of the field excluded as metal ("metal_fraction") and, with a cut-face margin, of
+/// the field whose rays clear the CT's cut faces at `T_world_from_ct` ("metal_fraction_covered": what the mask takes
+/// from the comparison). None with --no-metal-mask. Fails on a bad view (not expected: the case's own).
 Result<nlohmann::ordered_json> metalReport(const Options& o, const RegistrationCase& c,
                                            const Eigen::Isometry3d& T_world_from_ct, const std::string& when = {}) {
+  nlohmann::ordered_json report = nlohmann::ordered_json::object();
+  if (o.noMetalMask) return report;
   nlohmann::ordered_json fractions = nlohmann::ordered_json::object();
   nlohmann::ordered_json covered = nlohmann::ordered_json::object();
   const bool cutFaces = o.cutFaceMargin_mm >= 0.0;
@@ -215,12 +217,10 @@ Result<nlohmann::ordered_json> metalReport(const Options& o, const RegistrationC
       coveredText =
           fmt::format(" ({:.2f} % of the field whose rays clear the CT's cut faces)", 100.0 * fraction.value());
     }
-    if (!o.noMetalMask) {
-      fmt::print("view {}: metal mask excludes {:.2f} % of the field{}{}\n", c.viewName(v),
-                 100.0 * c.prepared(v).metalFraction, coveredText, when);
-    }
+    fmt::print("view {}: metal mask excludes {:.2f} % of the field{}{}\n", c.viewName(v),
+               100.0 * c.prepared(v).metalFraction, coveredText, when);
   }
-  nlohmann::ordered_json report{{"metal_fraction", std::move(fractions)}};
+  report["metal_fraction"] = std::move(fractions);
   if (cutFaces) report["metal_fraction_covered"] = std::move(covered);
   return report;
 }
@@ -287,7 +287,7 @@ std::optional<TruthError> truthError(const Inputs& in, const RegistrationCase& c
 }
 
 /// RESULT.json: the result object (RegistrationResultJson) with where the initial pose came from, the command's
-/// options, the Transgraph tables, the metal fractions (unless --no-metal-mask) and the error against --truth added.
+/// options, the Transgraph tables, the metal mask's members (metalReport) and the error against --truth added.
 nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r, nlohmann::ordered_json initialSource,
                                   nlohmann::ordered_json transgraph, nlohmann::ordered_json metal,
                                   const std::optional<TruthError>& error) {
@@ -307,9 +307,7 @@ nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r,
   for (const auto& item : json["options"].items()) options[item.key()] = item.value();
   json["options"] = std::move(options);
   json["transgraph"] = std::move(transgraph);
-  if (!o.noMetalMask) {
-    for (auto& item : metal.items()) json[item.key()] = std::move(item.value());
-  }
+  for (auto& item : metal.items()) json[item.key()] = std::move(item.value());
   if (error) {
     json["error_vs_truth"] = {{"initial_mean_surface_mm", error->initialMean_mm},
                               {"final_mean_surface_mm", error->finalMean_mm},
@@ -434,7 +432,7 @@ int runRegister(const Options& o) {
   const RegistrationResult& r = result.value();
   const bool reviewed =
       std::any_of(r.stages.begin(), r.stages.end(), [](const StageReport& s) { return s.metalPiecesGivenBack > 0; });
-  if (reviewed || o.cutFaceMargin_mm >= 0.0) {  // the mask, or the rays the CT covers, changed since the first report
+  if (reviewed || metal.value().contains("metal_fraction_covered")) {  // the mask, or the rays the CT covers, moved
     metal = metalReport(o, registrationCase.value(), r.T_world_from_ct,
                         reviewed ? " after the metal review" : " at the final pose");
     if (!metal) return reportError(metal.error());

@@ -281,7 +281,6 @@ RegistrationCaseOptions caseOptionsFor(const StudySetup& setup) {
   RegistrationCaseOptions caseOptions;
   caseOptions.drr.method = setup.method;
   caseOptions.drr.transgraph.spacing_mm = setup.transgraphSpacing_mm;
-  caseOptions.cutFaceMargin_mm = StudyRunner::kCutFaceMargin_mm;
   caseOptions.drr.transgraphCacheFolder = setup.transgraphCacheDir.empty()
                                               ? std::nullopt
                                               : std::optional<std::filesystem::path>(setup.transgraphCacheDir);

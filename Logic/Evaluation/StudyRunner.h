@@ -27,7 +27,6 @@
 #include "Evaluation/StudyShard.h"
 #include "Evaluation/TrialStore.h"
 #include "Image/BoneSurface.h"
-#include "Registration/RegistrationCase.h"
 #include "Image/Volume.h"
 #include "Registration/RegistrationSchedule.h"
 
@@ -68,9 +67,6 @@ class StudyRunner {
  public:
   /// The most trials run in parallel.
   static constexpr int kMaxJobs = 64;
-  /// The cut-face margin (RegistrationCaseOptions::cutFaceMargin_mm) of every study registration: the simulated
-  /// patient continues beyond the CT's end faces.
-  static constexpr double kCutFaceMargin_mm = RegistrationCaseOptions::kDefaultCutFaceMargin_mm;
 
   /// Runs the missing trials of `study` on `cts`, adding each to `store`. Fails before any trial on jobs outside
   /// 1..kMaxJobs, a condition naming a CT not in `cts`, a view count outside 1..5, no trials, a bad initial range, an

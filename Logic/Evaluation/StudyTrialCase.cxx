@@ -10,6 +10,7 @@
 #include "Evaluation/StudyXraySource.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Volume/VolumeFileIO.h"
+#include "Registration/RegistrationCase.h"
 #include "Simulation/FluoroscopySimulator.h"
 #include "Simulation/StandardViews.h"
 
@@ -81,7 +82,7 @@ Result<StudyTrialCaseFiles> StudyTrialCase::write(const StudyDefinition& study, 
       return fail(written.error());
     }
   }
-  files.cutFaceMargin_mm = StudyRunner::kCutFaceMargin_mm;
+  files.cutFaceMargin_mm = RegistrationCaseOptions::kDefaultCutFaceMargin_mm;
   files.initialStre_mm = metrics.value().measure(start.value(), T_truth).streMean_mm;
   return files;
 }

@@ -169,9 +169,7 @@ Result<std::vector<TrackingFrameRecord>> runSequence(const TrackingStudyDefiniti
   for (std::size_t v = 0; v < views.value().size(); ++v) {
     firstViews.push_back(RegistrationView{views.value()[v].name, images[0][v], views.value()[v].camera, {}});
   }
-  RegistrationCaseOptions caseOptions;
-  caseOptions.cutFaceMargin_mm = StudyRunner::kCutFaceMargin_mm;  // the simulated patient continues beyond the CT
-  auto registrationCase = RegistrationCase::create(*scene.ct, firstViews, caseOptions);
+  auto registrationCase = RegistrationCase::create(*scene.ct, firstViews);  // the default cut-face margin
   if (!registrationCase) return fail(fmt::format("condition '{}': {}", c.name, registrationCase.error()));
   auto tracker = CineTracker::create(registrationCase.value(), trackerOptions);
   if (!tracker) return fail(fmt::format("condition '{}': {}", c.name, tracker.error()));

@@ -44,7 +44,8 @@ struct RegistrationCaseOptions {
   DrrRendererOptions drr;                  ///< DRR method ("siddon", "raycast", ...)
   XrayPreparationOptions preparation;      ///< masks, intensity model, pyramid levels (spheres come per view)
   double boneThreshold_hu = 250.0;         ///< iso-value of the bone surface giving the rotation centre and radius
-  /// The cut-face margin of a case unless told otherwise, and of every evaluation study (mm).
+  /// The cut-face margin of a case unless told otherwise, and so of every evaluation study and tracking study (mm):
+  /// the simulated patient continues beyond the CT's end faces, as a real one does.
   static constexpr double kDefaultCutFaceMargin_mm = 5.0;
   /// Pixels whose rays cross the patient beyond the CT's end faces along its slice axis, or pass within this many mm
   /// of them, at the initial pose, are left out of the comparison (CutFaceRayMask): the X-ray shows anatomy there

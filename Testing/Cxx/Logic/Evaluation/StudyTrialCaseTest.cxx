@@ -14,6 +14,7 @@
 #include "IO/Project/ViewFile.h"
 #include "IO/Volume/VolumeFileIO.h"
 #include "IO/Xray/XrayLoader.h"
+#include "Registration/RegistrationCase.h"
 #include "Simulation/PhantomBuilder.h"
 #include "TestSupport.h"
 
@@ -89,7 +90,7 @@ TEST(StudyTrialCase, WritesTheTrialsOwnXraysTruthAndStartAndTheCoarserRegistrati
   ASSERT_TRUE(ct.ok()) << ct.error();
   const auto degraded = fct::StudyXraySource::registrationCt(q.cts[0].volume, realistic->sliceSpacing_mm).value();
   EXPECT_EQ(ct.value().dims(), degraded.dims());
-  EXPECT_DOUBLE_EQ(files.value().cutFaceMargin_mm, fct::StudyRunner::kCutFaceMargin_mm);
+  EXPECT_DOUBLE_EQ(files.value().cutFaceMargin_mm, fct::RegistrationCaseOptions::kDefaultCutFaceMargin_mm);
 }
 
 TEST(StudyTrialCase, NamesTheStudyCtFileWhenTheTrialRegistersOnIt) {
