@@ -6,6 +6,8 @@
 #include <csignal>
 #include <cstdio>
 
+#include "Registration/RegistrationCase.h"
+
 namespace fct::cli {
 
 namespace {
@@ -49,6 +51,27 @@ CLI::Validator positiveNumber() {
         return fmt::format("must be a positive number, got '{}'", text);
       },
       "POSITIVE");
+}
+
+void addCutFaceMarginOption(CLI::App& command, double& margin_mm) {
+  const CLI::Validator atMostTheLargest(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) &&
+            value <= RegistrationCaseOptions::kMaxCutFaceMargin_mm) {
+          return {};
+        }
+        return fmt::format("must be a number of mm up to {:g} (negative: off), got '{}'",
+                           RegistrationCaseOptions::kMaxCutFaceMargin_mm, text);
+      },
+      "MM");
+  command
+      .add_option("--cut-face-margin-mm", margin_mm,
+                  "Leave out the pixels whose rays, at the initial pose, cross the patient beyond the CT's first or "
+                  "last slice or pass within this many mm of those cut faces (the X-ray shows anatomy there that the "
+                  "CT lacks); negative = off")
+      ->check(atMostTheLargest)
+      ->capture_default_str();
 }
 
 InterruptGuard::InterruptGuard() {

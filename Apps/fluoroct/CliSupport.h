@@ -37,6 +37,10 @@ std::optional<std::filesystem::path> transgraphCacheFolder(const std::string& op
 /// Option check: the value must be a finite number > 0; the message names the value given.
 CLI::Validator positiveNumber();
 
+/// Adds --cut-face-margin-mm (register, track) bound to `margin_mm`: a finite number of mm up to
+/// RegistrationCaseOptions::kMaxCutFaceMargin_mm, negative for off, shown with its default.
+void addCutFaceMarginOption(CLI::App& command, double& margin_mm);
+
 /// While alive, Ctrl-C (SIGINT) sets cancelFlag() instead of ending the process, so a long Logic operation can stop
 /// cleanly; the previous handler is restored when the guard goes, on every path out of its scope. Create one at a time.
 class InterruptGuard {

@@ -526,11 +526,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                       "Line integral a narrow shadow must add over its surroundings to count as metal (-ln of the "
                       "fraction of signal it passes; physical, log-linear detector images)")
       ->capture_default_str();
-  command->add_option("--cut-face-margin-mm", options->cutFaceMargin_mm,
-                      "Leave out the pixels whose rays, at the initial pose, cross the patient beyond the CT's first "
-                      "or last slice or pass within this many mm of those cut faces (the X-ray shows anatomy there "
-                      "that the CT lacks); negative = off")
-      ->capture_default_str();
+  addCutFaceMarginOption(*command, options->cutFaceMargin_mm);
   command->add_option("--masks", options->masks,
                       "Folder for one PNG per view (<view>_mask.png): white pixels are compared with the DRR, black "
                       "ones excluded (field border, margin, calibration spheres, metal; rewritten after a metal review)");

@@ -45,6 +45,7 @@ struct Options {
   CineTrackerOptions tracker;
   bool noFieldOfView = false;
   bool noMetalMask = false;
+  double cutFaceMargin_mm = RegistrationCaseOptions::kDefaultCutFaceMargin_mm;
   std::string igtl;
   std::string igtlDevice = "FluoroCT";
 };
@@ -99,7 +100,8 @@ Result<std::vector<XrayImage>> loadFrame(const Inputs& in, int f) {
   return images;
 }
 
-/// The case options: DRR method (Transgraph tables around the initial pose), field-of-view and metal exclusions.
+/// The case options: DRR method (Transgraph tables around the initial pose), field-of-view and metal exclusions, the
+/// cut-face margin.
 RegistrationCaseOptions caseOptionsFor(const Options& o, DrrMethod method, const Eigen::Isometry3d& T_initial) {
   RegistrationCaseOptions options;
   options.drr.method = method;
@@ -107,6 +109,7 @@ RegistrationCaseOptions caseOptionsFor(const Options& o, DrrMethod method, const
   if (method == DrrMethod::Transgraph) options.T_expected_world_from_ct = T_initial;
   options.preparation.detectFieldOfView = !o.noFieldOfView;
   options.preparation.excludeMetal = !o.noMetalMask;
+  options.cutFaceMargin_mm = o.cutFaceMargin_mm;
   return options;
 }
 
@@ -157,6 +160,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                  {{"ct", o.ct},
                                   {"views", o.views},
                                   {"preset", o.preset},
+                                  {"cut_face_margin_mm", o.cutFaceMargin_mm},
                                   {"level", run.tracker.level},
                                   {"roi_fraction", run.tracker.roiFraction},
                                   {"max_evaluations", run.tracker.maxEvaluations},
@@ -384,6 +388,7 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
       ->capture_default_str();
   command->add_flag("--no-fov", options->noFieldOfView, "Skip the field-of-view (collimator) detection");
   command->add_flag("--no-metal-mask", options->noMetalMask, "Compare metal shadows too instead of excluding them");
+  addCutFaceMarginOption(*command, options->cutFaceMargin_mm);
   auto* igtl = command->add_option("--igtl", options->igtl,
                                    "Send each frame's pose to an OpenIGTLink server HOST:PORT as a TRANSFORM (RAS)");
   command->add_option("--igtl-device", options->igtlDevice, "Device name of the TRANSFORM (1-20 characters)")

@@ -44,8 +44,9 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   if (!renderer) return fail(renderer.error());
   result.m_renderer = std::move(renderer).value();
   result.m_viewRenderersReady = options.drr.method != DrrMethod::Transgraph;
-  if (!(options.cutFaceMargin_mm <= 500.0)) {  // also NaN
-    return fail(fmt::format("cut-face margin must be at most 500 mm (negative: off), got {}", options.cutFaceMargin_mm));
+  if (!(options.cutFaceMargin_mm <= RegistrationCaseOptions::kMaxCutFaceMargin_mm)) {  // also NaN
+    return fail(fmt::format("cut-face margin must be at most {} mm (negative: off), got {}",
+                            RegistrationCaseOptions::kMaxCutFaceMargin_mm, options.cutFaceMargin_mm));
   }
   if (options.cutFaceMargin_mm >= 0.0) {
     auto cutFaces = CutFaceRayMask::create(*result.m_drrVolume, options.cutFaceMargin_mm);

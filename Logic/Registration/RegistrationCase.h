@@ -47,6 +47,8 @@ struct RegistrationCaseOptions {
   /// The cut-face margin of a case unless told otherwise, and so of every evaluation study and tracking study (mm):
   /// the simulated patient continues beyond the CT's end faces, as a real one does.
   static constexpr double kDefaultCutFaceMargin_mm = 5.0;
+  /// The largest cut-face margin a case takes (mm): beyond it the mask would leave out nearly every ray.
+  static constexpr double kMaxCutFaceMargin_mm = 500.0;
   /// Pixels whose rays cross the patient beyond the CT's end faces along its slice axis, or pass within this many mm
   /// of them, at the initial pose, are left out of the comparison (CutFaceRayMask): the X-ray shows anatomy there
   /// that the CT lacks. Negative: off. The mask is made at the initial pose (and again at a stage's start when the

@@ -253,6 +253,14 @@ TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
   EXPECT_TRUE(oneErrorLine(badMetal)) << badMetal.err;
   EXPECT_NE(badMetal.err.find("minimum excess"), std::string::npos) << badMetal.err;
 
+  // A cut-face margin beyond the largest, or not a number: refused by the flag, before anything is read.
+  for (const std::string margin : {"600", "nan"}) {
+    const auto badMargin = fct::test::runCli(base + init + " --cut-face-margin-mm " + margin);
+    EXPECT_TRUE(oneErrorLine(badMargin)) << badMargin.err;
+    EXPECT_NE(badMargin.err.find("--cut-face-margin-mm"), std::string::npos) << badMargin.err;
+    EXPECT_NE(badMargin.err.find("up to 500"), std::string::npos) << badMargin.err;
+  }
+
   Eigen::Isometry3d far = truth;
   far.translation().z() += 900.0;
   ASSERT_TRUE(fct::PoseFile::write(far, dir / "far.json").ok());

@@ -26,7 +26,8 @@ TEST(TrackCommand, TracksATinyBiplaneSequenceAndWritesJsonCsvAndPlot) {
   const std::vector<Eigen::Isometry3d> truth = fct::test::makeTrackCase(dir, 4);
   ASSERT_TRUE(fct::PoseFile::write(fct::test::perturbed(truth[0]), dir / "init.json").ok());
   const auto run =
-      fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) + " --level 0");
+      fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
+                        " --level 0 --cut-face-margin-mm 2");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("tracked 4 of 4 frames"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("frame    3/4"), std::string::npos) << run.err;
@@ -38,6 +39,7 @@ TEST(TrackCommand, TracksATinyBiplaneSequenceAndWritesJsonCsvAndPlot) {
   EXPECT_EQ(json.value().at("cancelled"), false);
   EXPECT_EQ(json.value().at("options").at("frame_drr"), "siddon") << "the automatic choice for two views";
   EXPECT_EQ(json.value().at("options").at("depth_scale"), 10.0);
+  EXPECT_EQ(json.value().at("options").at("cut_face_margin_mm"), 2.0);
   EXPECT_GT(json.value().at("frames_per_second").get<double>(), 0.0);
   for (std::size_t f = 0; f < frames.size(); ++f) {
     EXPECT_EQ(frames[f].at("index"), static_cast<int>(f));
@@ -87,7 +89,8 @@ TEST(TrackCommand, BadInputsGiveOneClearErrorLine) {
       {" --depth-scale 0.5", "depth scale"},
       {" --frame-drr transgraph", "--frame-drr"},
       {" --frame-drr box", "--frame-drr"},
-      {" --confirm-mm 0", "confirmation tolerances"}};
+      {" --confirm-mm 0", "confirmation tolerances"},
+      {" --cut-face-margin-mm 600", "--cut-face-margin-mm"}};
   for (const auto& [option, expected] : badOptions) {
     run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) + option);
     EXPECT_TRUE(fct::test::oneErrorLine(run)) << option << ": " << run.err;
