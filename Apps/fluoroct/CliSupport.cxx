@@ -5,6 +5,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <utility>
 
 #include "Registration/RegistrationCase.h"
 
@@ -43,34 +44,35 @@ std::optional<std::filesystem::path> transgraphCacheFolder(const std::string& op
   return std::filesystem::path(option);
 }
 
-CLI::Validator positiveNumber() {
+namespace {
+
+/// Option check: the value must be a finite number that `accepts` takes; else "must be REQUIREMENT, got 'TEXT'".
+CLI::Validator finiteNumber(bool (*accepts)(double), std::string requirement, std::string name) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
+      [accepts, requirement](std::string& text) -> std::string {
         double value = 0.0;
-        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) && value > 0.0) return {};
-        return fmt::format("must be a positive number, got '{}'", text);
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) && accepts(value)) return {};
+        return fmt::format("must be {}, got '{}'", requirement, text);
       },
-      "POSITIVE");
+      std::move(name));
+}
+
+}  // namespace
+
+CLI::Validator positiveNumber() {
+  return finiteNumber([](double value) { return value > 0.0; }, "a positive number", "POSITIVE");
 }
 
 void addCutFaceMarginOption(CLI::App& command, double& margin_mm) {
-  const CLI::Validator atMostTheLargest(
-      [](std::string& text) -> std::string {
-        double value = 0.0;
-        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) &&
-            value <= RegistrationCaseOptions::kMaxCutFaceMargin_mm) {
-          return {};
-        }
-        return fmt::format("must be a number of mm up to {:g} (negative: off), got '{}'",
-                           RegistrationCaseOptions::kMaxCutFaceMargin_mm, text);
-      },
-      "MM");
   command
       .add_option("--cut-face-margin-mm", margin_mm,
-                  "Leave out the pixels whose rays, at the initial pose, cross the patient beyond the CT's first or "
-                  "last slice or pass within this many mm of those cut faces (the X-ray shows anatomy there that the "
-                  "CT lacks); negative = off")
-      ->check(atMostTheLargest)
+                  "Leave out the pixels whose rays, at the pose a search starts from, cross the patient beyond the "
+                  "CT's first or last slice or pass within this many mm of those cut faces (the X-ray shows anatomy "
+                  "there that the CT lacks); negative = off")
+      ->check(finiteNumber([](double value) { return value <= RegistrationCaseOptions::kMaxCutFaceMargin_mm; },
+                           fmt::format("a number of mm up to {:g} (negative: off)",
+                                       RegistrationCaseOptions::kMaxCutFaceMargin_mm),
+                           "MM"))
       ->capture_default_str();
 }
 
