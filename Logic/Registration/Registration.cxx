@@ -504,6 +504,16 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
         if (!rebuilt) return fail(rebuilt.error());
       }
     }
+    if (stage.metric == SimilarityMetric::Vlnc && stage.vlncWeights == VlncWeightSource::Drr) {
+      const Eigen::Isometry3d T_weights = registrationCase.poseTransform(current);
+      auto weighed = registrationCase.weighWindowsWithDrr(T_weights);
+      if (!weighed) return fail(fmt::format("stage '{}': {}", stage.name, weighed.error()));
+      stageStart.preSearchDrrs += weighed.value();
+      // The weights changed: the stages from here on make their similarities again.
+      const Status rebuilt = remakeObjectivesFrom(registrationCase, schedule, i, options.ablation, useViewRenderers,
+                                                  T_weights, objectives.value(), T_objectives);
+      if (!rebuilt) return fail(rebuilt.error());
+    }
     if (stage.shiftPrealign) {
       auto outcome = prealignByShift(registrationCase, stage, objectives.value()[i], current);
       if (!outcome) return fail(outcome.error());

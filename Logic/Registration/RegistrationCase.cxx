@@ -64,7 +64,7 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
     if (!prepared) return fail(prepared.error());
     result.m_views.push_back(
         View{view.name, view.camera, std::move(preparation), std::move(prepared).value(), std::nullopt, {},
-             result.m_renderer, nullptr});
+             result.m_renderer, nullptr, std::nullopt});
   }
 
   if (cancelled()) return fail(kCancelledError);
@@ -193,7 +193,40 @@ Result<HazeRemovalSummary> RegistrationCase::removeHaze(const Eigen::Isometry3d&
   return summary;
 }
 
+Result<int> RegistrationCase::weighWindowsWithDrr(const Eigen::Isometry3d& T_world_from_ct) {
+  std::vector<Status> statuses(m_views.size(), Ok{});
+  std::vector<std::optional<XrayPyramid>> pyramids(m_views.size());  // all made before any view changes
+  tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
+    const View& view = m_views[v];
+    auto drr = m_renderer->render(view.camera, T_world_from_ct, 0);
+    if (!drr) {
+      statuses[v] = fail(fmt::format("view '{}': window weights: {}", view.name, drr.error()));
+      return;
+    }
+    auto pyramid = XrayPyramid::build(drr.value(), view.prepared.pyramid.level(0).mask, view.camera, levelCount());
+    if (!pyramid) {
+      statuses[v] = fail(fmt::format("view '{}': window weights: pyramid: {}", view.name, pyramid.error()));
+      return;
+    }
+    pyramids[v] = std::move(pyramid).value();
+  });
+  for (const Status& status : statuses) {
+    if (!status) return fail(status.error());
+  }
+  for (std::size_t v = 0; v < m_views.size(); ++v) m_views[v].windowWeights = std::move(pyramids[v]);
+  return static_cast<int>(m_views.size());
+}
+
+const FloatImage* RegistrationCase::windowWeightImage(std::size_t v, int level) const {
+  if (v >= m_views.size() || !m_views[v].windowWeights || level < 0 ||
+      level >= m_views[v].windowWeights->levelCount()) {
+    return nullptr;
+  }
+  return &m_views[v].windowWeights->level(level).image;
+}
+
 Status RegistrationCase::restorePreparedXrays() {
+  for (View& view : m_views) view.windowWeights.reset();
   for (View& view : m_views) {
     if (!view.preparedImage) continue;
     auto pyramid = XrayPyramid::build(*view.preparedImage, view.prepared.pyramid.level(0).mask, view.camera,

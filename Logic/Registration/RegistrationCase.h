@@ -152,8 +152,17 @@ class RegistrationCase {
   /// call replaces the first; restorePreparedXrays() undoes it. A view whose fit fails (a pose far off) keeps its
   /// X-ray and is named in the summary. Fails, naming the view, when a DRR cannot be rendered or a pyramid rebuilt.
   Result<HazeRemovalSummary> removeHaze(const Eigen::Isometry3d& T_world_from_ct, double hazeSigma_mm);
-  /// Gives every view corrected by removeHaze() its X-ray as prepared back (its current masks kept); nothing to do when
-  /// none was corrected. Fails, naming the view, when a pyramid cannot be rebuilt.
+  /// Renders a DRR of every view at T_world_from_ct (a pose near the truth; the case's renderer, full resolution) whose
+  /// window variances weigh the views' VLNC windows from now on (windowWeightImage), the X-ray's own variances counting
+  /// its noise too. A second call replaces the first; restorePreparedXrays() drops them. Returns the DRRs rendered.
+  /// Fails, naming the view and leaving every view as it was, when a DRR cannot be rendered or its pyramid built.
+  Result<int> weighWindowsWithDrr(const Eigen::Isometry3d& T_world_from_ct);
+  /// View v's image at pyramid `level` whose window variances weigh its VLNC windows (weighWindowsWithDrr), or null
+  /// when the X-ray's own do.
+  const FloatImage* windowWeightImage(std::size_t v, int level) const;
+  /// Gives every view corrected by removeHaze() its X-ray as prepared back (its current masks kept) and drops the DRRs
+  /// of weighWindowsWithDrr(); nothing to do when there are none. Fails, naming the view, when a pyramid cannot be
+  /// rebuilt.
   Status restorePreparedXrays();
   /// Rays passing within this distance of the CT's cut faces (mm) are not used by the haze fit: beyond them the X-ray
   /// shows anatomy the DRR lacks.
@@ -209,6 +218,7 @@ class RegistrationCase {
     std::map<std::pair<int, int>, DynamicRoiSelector> selectors;  ///< by (level, window size)
     std::shared_ptr<const DrrRenderer> renderer;                  ///< the view's renderer (see renderer(v))
     const TransgraphRenderer* transgraph = nullptr;               ///< the same renderer when it is a Transgraph
+    std::optional<XrayPyramid> windowWeights;  ///< the DRR pyramid of weighWindowsWithDrr(), if any
   };
   /// Prepares `xray` for the view `name` with `camera`: the preparation, and the checks of its size and contrast.
   /// Fails naming the view.

@@ -188,7 +188,11 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
         break;
       }
       case SimilarityMetric::Vlnc: {
-        auto metric = VlncSimilarity::create(pyramidLevel.image, selection, stage.vlncDomain);
+        // A stage weighing its windows with a DRR uses the X-ray's variances until its start has rendered that DRR
+        // (Registration makes the stage's objective again there).
+        const FloatImage* weightImage =
+            stage.vlncWeights == VlncWeightSource::Drr ? registrationCase.windowWeightImage(v, level) : nullptr;
+        auto metric = VlncSimilarity::create(pyramidLevel.image, selection, stage.vlncDomain, weightImage);
         if (!metric) return fail(fmt::format("{}: {}", where(v), metric.error()));
         view.metric = std::make_unique<VlncSimilarity>(std::move(metric).value());
         break;

@@ -33,7 +33,8 @@ class RegistrationObjective {
   /// footprint at that pose (RegistrationCase::levelRenderer; the CT pyramid). Given T_cutFaces_world_from_ct, the
   /// pixels (VLNC: the windows with a pixel) whose rays at that pose cross the CT's cut faces are left out
   /// (RegistrationCase::cutFaceMask), unless that leaves a view no pixel (no complete window for VLNC): then that view
-  /// keeps its unmasked set in that stage.
+  /// keeps its unmasked set in that stage. A VLNC stage with DRR window weights weighs its windows with the case's
+  /// windowWeightImage(), or with the X-ray's variances while the case has none.
   static Result<RegistrationObjective> create(
       RegistrationCase& registrationCase, const RegistrationStage& stage, bool useViewRenderers = true,
       const std::optional<Eigen::Isometry3d>& T_coarseCt_world_from_ct = std::nullopt,

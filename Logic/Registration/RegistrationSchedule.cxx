@@ -30,6 +30,8 @@ constexpr NameTable<LocalSearchMethod, 2> kLocalMethods{
 constexpr NameTable<DrrMethod, 2> kStageDrrMethods{{{"siddon", DrrMethod::Siddon}, {"raycast", DrrMethod::RayCast}}};
 constexpr NameTable<VlncDomain, 2> kVlncDomains{
     {{"line_integral", VlncDomain::LineIntegral}, {"intensity", VlncDomain::Intensity}}};
+constexpr NameTable<VlncWeightSource, 2> kVlncWeightSources{
+    {{"xray", VlncWeightSource::Xray}, {"drr", VlncWeightSource::Drr}}};
 constexpr NameTable<PixelSetKind, 2> kPixelSets{
     {{"whole", PixelSetKind::WholeImage}, {"rois", PixelSetKind::Rois}}};
 
@@ -109,6 +111,12 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
     stage.vlncDomain = parseName(reader, "domain", kVlncDomains);
     if (reader.ok() && stage.metric != SimilarityMetric::Vlnc) {
       reader.rejectKey("domain", "applies only with \"metric\": \"vlnc\"");
+    }
+  }
+  if (reader.has("weights")) {
+    stage.vlncWeights = parseName(reader, "weights", kVlncWeightSources);
+    if (reader.ok() && stage.metric != SimilarityMetric::Vlnc) {
+      reader.rejectKey("weights", "applies only with \"metric\": \"vlnc\"");
     }
   }
   optionalFlag(reader, "exact_drr", stage.exactDrr);
@@ -306,6 +314,9 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
                                      {"exact_drr", s.exactDrr}};
     if (s.metric == SimilarityMetric::Vlnc && s.vlncDomain != VlncDomain::LineIntegral) {
       stageJson["domain"] = nameOf(s.vlncDomain, kVlncDomains);  // other metrics compare line integrals
+    }
+    if (s.metric == SimilarityMetric::Vlnc && s.vlncWeights != VlncWeightSource::Xray) {
+      stageJson["weights"] = nameOf(s.vlncWeights, kVlncWeightSources);
     }
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;

@@ -32,6 +32,11 @@ enum class PixelSetKind {
 };
 /// The search strategy of a stage.
 enum class SearchStrategy { Genetic, CmaEs, Local };
+/// Where a VLNC stage's window weights come from.
+enum class VlncWeightSource {
+  Xray,  ///< each window's X-ray variance (the paper's)
+  Drr,   ///< each window's variance in a DRR at the stage's start (RegistrationCase::weighWindowsWithDrr)
+};
 
 /// The pixel set of a stage.
 struct PixelSetSpec {
@@ -81,6 +86,10 @@ struct RegistrationStage {
   /// every X-ray with a DRR at the stage's start (RegistrationCase::removeHaze); the stages after it compare the
   /// corrected X-rays too. 0: off. For a stage that starts near the truth (JSON "haze_sigma_mm").
   double hazeSigma_mm = 0.0;
+  /// VLNC: weigh each window by its variance in the X-ray (the paper's) or in a DRR rendered at the stage's start
+  /// (after the haze removal). Noise-free, the DRR weighs a window by the structure the CT predicts there, not by the
+  /// X-ray's noise (JSON "weights": "xray" or "drr"; docs/evaluation.md, "Window weights").
+  VlncWeightSource vlncWeights = VlncWeightSource::Xray;
   /// Before the search (after the shift pre-alignment), look around the start's rotation on a coarse grid; the poses
   /// that beat the start are refined beside it (genetic) or replace it (local, CMA-ES: the best one).
   RotationSweepSpec rotationSweep;

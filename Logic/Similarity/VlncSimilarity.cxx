@@ -16,17 +16,22 @@ float intensityOf(float lineIntegral) { return std::exp(-lineIntegral); }
 }  // namespace
 
 Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiSelection& selection,
-                                              VlncDomain domain) {
+                                              VlncDomain domain, const FloatImage* weightSource) {
   const int w = selection.windowSize;
   if (selection.windows.empty() || w <= 0) {
     return fail("VLNC needs at least one window; the ROI selection is empty (lower the threshold or raise the "
                 "target fraction)");
+  }
+  if (weightSource && (weightSource->cols != xray.cols || weightSource->rows != xray.rows)) {
+    return fail(fmt::format("VLNC window weights: the weight image is {}x{} but the X-ray {}x{}", weightSource->cols,
+                            weightSource->rows, xray.cols, xray.rows));
   }
   VlncSimilarity metric(xray.cols, xray.rows);
   metric.m_domain = domain;
   const bool intensity = domain == VlncDomain::Intensity;
   metric.m_windowPixels = static_cast<std::size_t>(w) * w;
   std::vector<float> values(metric.m_windowPixels);
+  std::vector<float> weightValues(weightSource ? metric.m_windowPixels : 0);
   PixelIndexList indices(metric.m_windowPixels);
   double varianceSum = 0.0;
   for (const RoiWindow& window : selection.windows) {
@@ -36,28 +41,43 @@ Result<VlncSimilarity> VlncSimilarity::create(const FloatImage& xray, const RoiS
                               window.col0, window.row0, w, xray.cols, xray.rows));
     }
     std::size_t k = 0;
+    bool finite = true, weightsFinite = true;
     for (int r = window.row0; r < window.row0 + w; ++r) {
       for (int c = window.col0; c < window.col0 + w; ++c, ++k) {
         indices[k] = r * xray.cols + c;
         const float lineIntegral = xray.pixels[static_cast<std::size_t>(indices[k])];
+        finite = finite && std::isfinite(lineIntegral);
         values[k] = intensity ? intensityOf(lineIntegral) : lineIntegral;
+        if (weightSource) {
+          const float weightLineIntegral = weightSource->pixels[static_cast<std::size_t>(indices[k])];
+          weightsFinite = weightsFinite && std::isfinite(weightLineIntegral);
+          weightValues[k] = intensity ? intensityOf(weightLineIntegral) : weightLineIntegral;
+        }
       }
     }
-    const double norm = NccAccumulator::centreInPlace(values.data(), values.size());
-    if (!std::isfinite(norm)) {
+    if (!finite) {
       return fail(fmt::format("X-ray has non-finite values in the window at ({},{})", window.col0, window.row0));
     }
-    if (norm == 0.0) continue;  // constant X-ray window: weight 0
+    if (!weightsFinite) {
+      return fail(fmt::format("VLNC window weights: the weight image has non-finite values in the window at ({},{})",
+                              window.col0, window.row0));
+    }
+    const double norm = NccAccumulator::centreInPlace(values.data(), values.size());
+    const double weightNorm =
+        weightSource ? NccAccumulator::centreInPlace(weightValues.data(), weightValues.size()) : norm;
+    if (norm == 0.0 || weightNorm == 0.0) continue;  // constant window: weight 0
     metric.m_pixels.insert(metric.m_pixels.end(), indices.begin(), indices.end());
     metric.m_xrayCentred.insert(metric.m_xrayCentred.end(), values.begin(), values.end());
     metric.m_xrayNorms.push_back(norm);
-    metric.m_weights.push_back(norm * norm);  // n * variance; n is common to all windows
-    varianceSum += norm * norm;
+    metric.m_weights.push_back(weightNorm * weightNorm);  // n * variance; n is common to all windows
+    varianceSum += weightNorm * weightNorm;
   }
   for (double& weight : metric.m_weights) weight /= varianceSum;
   Result<VlncSimilarity> result(std::move(metric));
   if (result.value().m_weights.empty()) {
-    result.addWarning("the X-ray is constant in every VLNC window; VLNC will be 0 for every pose");
+    result.addWarning(weightSource ? "every VLNC window is constant in the X-ray or in the weight image; VLNC will "
+                                     "be 0 for every pose"
+                                   : "the X-ray is constant in every VLNC window; VLNC will be 0 for every pose");
   }
   return result;
 }

@@ -6,6 +6,11 @@
 // NCC_w = 0. VLNC is in [-1, 1] and invariant to a gain and offset of either image (and to a different offset per
 // window). If every window's X-ray is constant, VLNC is 0 for every DRR.
 //
+// The weights may instead come from another image of the same detector (`weightSource`): var_x(w) is then that
+// image's variance in w. A noise-free DRR near the truth gives each window the structure the CT predicts there, where
+// an X-ray's own variance also counts its noise, and a haze-corrected X-ray's dark windows carry much amplified noise
+// (docs/evaluation.md, "Window weights").
+//
 // Both images are line integrals p (the DRR's sense). VLNC compares them as they are (the paper's: each window is
 // also invariant to a contrast scale, a first-order beam hardening), or as detector intensities exp(-p): each window
 // is then invariant to an added constant (a scatter haze, which in the line-integral sense bends dark windows'
@@ -31,10 +36,13 @@ enum class VlncDomain {
 class VlncSimilarity final : public ImageSimilarity {
  public:
   /// Prepares the X-ray side (line integrals) over the windows of `selection` (their position and size; weights are
-  /// recomputed from `xray` in `domain`). Fails on no window or a window not inside the image. All-constant windows
-  /// give a warning.
+  /// recomputed in `domain` from `weightSource`, line integrals of the same size, or from `xray` when it is null).
+  /// Windows constant in the X-ray or the weight source weigh nothing. Fails on no window, a window not inside the
+  /// image, or a weight source of another size or with non-finite values in a window. All-constant windows give a
+  /// warning.
   static Result<VlncSimilarity> create(const FloatImage& xray, const RoiSelection& selection,
-                                       VlncDomain domain = VlncDomain::LineIntegral);
+                                       VlncDomain domain = VlncDomain::LineIntegral,
+                                       const FloatImage* weightSource = nullptr);
 
   std::string name() const override { return "VLNC"; }
   /// Number of windows with a nonzero weight.

@@ -113,6 +113,24 @@ TEST(RegistrationSchedule, HazeRemovalIsReadAndWrittenOnlyWhereItIsOn) {
   }
 }
 
+TEST(RegistrationSchedule, DrrWindowWeightsAreReadAndWrittenOnlyWhereTheyAreAskedFor) {
+  const auto parsed = RegistrationSchedule::fromJson(
+      nlohmann::json::parse(R"({"name": "x", "stages": [{"name": "s", "metric": "vlnc", "level": 1,
+          "weights": "drr", "pixels": {"set": "rois"}, "search": {"strategy": "local", "max_evaluations": 10}}]})"),
+      "test.json");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().stages[0].vlncWeights, fct::VlncWeightSource::Drr);
+  const auto json = parsed.value().toJson();
+  EXPECT_EQ(json["stages"][0]["weights"], "drr");
+  const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(again.value().toJson(), json);
+  const auto paper = RegistrationSchedule::builtin("paper").value().toJson();
+  for (const auto& stage : paper["stages"]) {
+    EXPECT_FALSE(stage.contains("weights")) << "the X-ray's variances (the paper's) are the default and not written";
+  }
+}
+
 TEST(RegistrationSchedule, DepthScaleIsReadAndWrittenOnlyWhereItIsOn) {
   const auto parsed = RegistrationSchedule::fromJson(
       nlohmann::json::parse(R"({"name": "x", "stages": [{"name": "s", "metric": "vlnc", "level": 2,
@@ -184,6 +202,10 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
        "domain"},
       {stageHead + R"("metric": "vlnc", "level": 1, "haze_sigma_mm": 0.5, "pixels": {"set": "whole"}, )" + search + "]}",
        "haze_sigma_mm"},
+      {stageHead + R"("metric": "vlnc", "level": 1, "weights": "noise", "pixels": {"set": "whole"}, )" + search + "]}",
+       "weights"},
+      {stageHead + R"("metric": "ncc", "level": 1, "weights": "drr", "pixels": {"set": "whole"}, )" + search + "]}",
+       "weights"},
       {stageHead + R"("metric": "vlnc", "level": 1, "haze_sigma_mm": "15", "pixels": {"set": "whole"}, )" + search + "]}",
        "haze_sigma_mm"},
       {stageHead + R"("metric": "ncc", "level": 2, "rotation_sweep": {"step_deg": 10}, "pixels": {"set": "whole"}, )" +

@@ -87,6 +87,61 @@ TEST(VlncSimilarity, IsTheVarianceWeightedSumOfWindowNccs) {
   EXPECT_NEAR(vlnc.value().evaluate(drr).value(), 0.1 - 0.9, 1e-6);
 }
 
+TEST(VlncSimilarity, TakesItsWeightsFromAWeightImageWhenGiven) {
+  // The windows of IsTheVarianceWeightedSumOfWindowNccs, weighed by an image whose variances are 4 and 1 (weights
+  // 0.8, 0.2) instead of the X-ray's 1 and 9: the NCCs are still the X-ray's.
+  fct::FloatImage xray = fct::FloatImage::filled(14, 7);
+  fct::FloatImage weights = fct::FloatImage::filled(14, 7);
+  fct::FloatImage drr = fct::FloatImage::filled(14, 7);
+  for (int r = 0; r < 7; ++r) {
+    for (int c = 0; c < 7; ++c) {
+      const float sign = ((r + c) % 2) ? 1.0f : -1.0f;
+      xray.at(c, r) = sign;
+      xray.at(c + 7, r) = 3.0f * sign;
+      weights.at(c, r) = 2.0f * sign + 10.0f;
+      weights.at(c + 7, r) = -sign;
+      drr.at(c, r) = 5.0f * sign + 2.0f;
+      drr.at(c + 7, r) = -xray.at(c + 7, r);  // anti-correlated in window 2
+    }
+  }
+  fct::RoiSelection rois;
+  rois.windowSize = 7;
+  rois.windows = {fct::RoiWindow{0, 0, 0, 0}, fct::RoiWindow{7, 0, 0, 0}};
+  const auto own = fct::VlncSimilarity::create(xray, rois);
+  const auto weighed = fct::VlncSimilarity::create(xray, rois, fct::VlncDomain::LineIntegral, &weights);
+  ASSERT_TRUE(own.ok()) << own.error();
+  ASSERT_TRUE(weighed.ok()) << weighed.error();
+  EXPECT_NEAR(own.value().evaluate(drr).value(), 0.1 - 0.9, 1e-6);
+  EXPECT_NEAR(weighed.value().evaluate(drr).value(), 0.8 - 0.2, 1e-6);
+  // A window where the weight image is constant weighs nothing, whatever the X-ray shows there.
+  for (int r = 0; r < 7; ++r) {
+    for (int c = 7; c < 14; ++c) weights.at(c, r) = 3.0f;
+  }
+  const auto oneWindow = fct::VlncSimilarity::create(xray, rois, fct::VlncDomain::LineIntegral, &weights);
+  ASSERT_TRUE(oneWindow.ok());
+  EXPECT_EQ(oneWindow.value().windowCount(), 1u);
+  EXPECT_NEAR(oneWindow.value().evaluate(drr).value(), 1.0, 1e-6);
+}
+
+TEST(VlncSimilarity, RejectsNonFiniteWindowsAndAWeightImageOfAnotherSize) {
+  const fct::FloatImage xray = fct::test::phantomImage(21, 14);
+  fct::RoiSelection rois;
+  rois.windowSize = 7;
+  rois.windows = {fct::RoiWindow{7, 7, 0, 0}};
+  const fct::FloatImage smaller = fct::test::phantomImage(21, 13);
+  const auto wrongSize = fct::VlncSimilarity::create(xray, rois, fct::VlncDomain::LineIntegral, &smaller);
+  ASSERT_FALSE(wrongSize.ok());
+  EXPECT_NE(wrongSize.error().find("21x13"), std::string::npos) << wrongSize.error();
+  fct::FloatImage broken = xray;
+  broken.at(10, 10) = std::nanf("");
+  const auto nonFinite = fct::VlncSimilarity::create(xray, rois, fct::VlncDomain::LineIntegral, &broken);
+  ASSERT_FALSE(nonFinite.ok());
+  EXPECT_NE(nonFinite.error().find("weight image"), std::string::npos) << nonFinite.error();
+  const auto nanXray = fct::VlncSimilarity::create(broken, rois);
+  ASSERT_FALSE(nanXray.ok()) << "a NaN in the X-ray is refused too";
+  EXPECT_NE(nanXray.error().find("non-finite"), std::string::npos) << nanXray.error();
+}
+
 TEST(VlncSimilarity, ConstantXrayWindowsWeighNothing) {
   fct::FloatImage xray = fct::test::phantomImage(14, 7);
   for (int r = 0; r < 7; ++r) {
