@@ -144,30 +144,29 @@ Result<HazeRemovalSummary> RegistrationCase::removeHaze(const Eigen::Isometry3d&
   }
   auto cutFaces = CutFaceRayMask::create(*m_drrVolume, kHazeFitCutFaceMargin_mm);
   if (!cutFaces) return fail("haze removal: " + cutFaces.error());
-  // Each view's fit, in parallel: a failed render or mask fails the call, a failed fit keeps that view's X-ray.
+  int rendered = 0;
+  auto drrs = fullResolutionDrrs(T_world_from_ct, rendered);
+  if (!drrs) return fail("haze removal: " + drrs.error());
+  // Each view's fit, in parallel: a failed mask fails the call, a failed fit keeps that view's X-ray.
   std::vector<Status> statuses(m_views.size(), Ok{});
   std::vector<std::optional<Result<HazeCorrection>>> fits(m_views.size());
   tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
     const View& view = m_views[v];
-    auto drr = m_renderer->render(view.camera, T_world_from_ct, 0);
-    if (!drr) {
-      statuses[v] = fail(fmt::format("view '{}': haze removal: {}", view.name, drr.error()));
-      return;
-    }
+    const FloatImage& drr = (*drrs.value())[v];
     const PyramidLevel& full = view.prepared.pyramid.level(0);
     ValidMask fitMask = full.mask;
     if (const Status clear = fitMask.intersect(cutFaces.value().compute(view.camera, T_world_from_ct)); !clear) {
       statuses[v] = fail(fmt::format("view '{}': haze removal: {}", view.name, clear.error()));
       return;
     }
-    fits[v] = XrayHazeCorrector::correct(view.preparedImage ? *view.preparedImage : full.image, drr.value(), fitMask,
+    fits[v] = XrayHazeCorrector::correct(view.preparedImage ? *view.preparedImage : full.image, drr, fitMask,
                                          hazeSigma_mm / view.camera.intrinsics().pixelSpacing_mm.mean());
   });
   HazeRemovalSummary summary;
   for (std::size_t v = 0; v < m_views.size(); ++v) {
     if (!statuses[v]) return fail(statuses[v].error());
   }
-  summary.drrs = static_cast<int>(m_views.size());
+  summary.drrs = rendered;
   std::vector<std::optional<XrayPyramid>> pyramids(m_views.size());  // all built before any view changes
   for (std::size_t v = 0; v < m_views.size(); ++v) {
     const Result<HazeCorrection>& fit = *fits[v];
@@ -194,27 +193,42 @@ Result<HazeRemovalSummary> RegistrationCase::removeHaze(const Eigen::Isometry3d&
 }
 
 Result<int> RegistrationCase::weighWindowsWithDrr(const Eigen::Isometry3d& T_world_from_ct) {
-  std::vector<Status> statuses(m_views.size(), Ok{});
+  int rendered = 0;
+  auto drrs = fullResolutionDrrs(T_world_from_ct, rendered);
+  if (!drrs) return fail("window weights: " + drrs.error());
   std::vector<std::optional<XrayPyramid>> pyramids(m_views.size());  // all made before any view changes
-  tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
+  for (std::size_t v = 0; v < m_views.size(); ++v) {
     const View& view = m_views[v];
-    auto drr = m_renderer->render(view.camera, T_world_from_ct, 0);
-    if (!drr) {
-      statuses[v] = fail(fmt::format("view '{}': window weights: {}", view.name, drr.error()));
-      return;
-    }
-    auto pyramid = XrayPyramid::build(drr.value(), view.prepared.pyramid.level(0).mask, view.camera, levelCount());
-    if (!pyramid) {
-      statuses[v] = fail(fmt::format("view '{}': window weights: pyramid: {}", view.name, pyramid.error()));
-      return;
-    }
+    auto pyramid = XrayPyramid::build((*drrs.value())[v], view.prepared.pyramid.level(0).mask, view.camera,
+                                      levelCount());
+    if (!pyramid) return fail(fmt::format("view '{}': window weights: pyramid: {}", view.name, pyramid.error()));
     pyramids[v] = std::move(pyramid).value();
+  }
+  for (std::size_t v = 0; v < m_views.size(); ++v) m_views[v].windowWeights = std::move(pyramids[v]);
+  return rendered;
+}
+
+Result<const std::vector<FloatImage>*> RegistrationCase::fullResolutionDrrs(const Eigen::Isometry3d& T_world_from_ct,
+                                                                           int& rendered) {
+  rendered = 0;
+  if (m_fullDrrPose && m_fullDrrPose->matrix() == T_world_from_ct.matrix()) return &m_fullDrrs;
+  std::vector<Status> statuses(m_views.size(), Ok{});
+  std::vector<FloatImage> drrs(m_views.size());
+  tbb::parallel_for(std::size_t{0}, m_views.size(), [&](std::size_t v) {
+    auto drr = m_renderer->render(m_views[v].camera, T_world_from_ct, 0);
+    if (!drr) {
+      statuses[v] = fail(fmt::format("view '{}': {}", m_views[v].name, drr.error()));
+      return;
+    }
+    drrs[v] = std::move(drr).value();
   });
   for (const Status& status : statuses) {
     if (!status) return fail(status.error());
   }
-  for (std::size_t v = 0; v < m_views.size(); ++v) m_views[v].windowWeights = std::move(pyramids[v]);
-  return static_cast<int>(m_views.size());
+  m_fullDrrs = std::move(drrs);
+  m_fullDrrPose = T_world_from_ct;
+  rendered = static_cast<int>(m_views.size());
+  return &m_fullDrrs;
 }
 
 const FloatImage* RegistrationCase::windowWeightImage(std::size_t v, int level) const {

@@ -156,6 +156,7 @@ class RegistrationCase {
   /// window variances weigh the views' VLNC windows from now on (windowWeightImage), the X-ray's own variances counting
   /// its noise too. A second call replaces the first; restorePreparedXrays() drops them. Returns the DRRs rendered.
   /// Fails, naming the view and leaving every view as it was, when a DRR cannot be rendered or its pyramid built.
+  /// At the pose of a removeHaze() just before, it uses that call's DRRs (0 rendered).
   Result<int> weighWindowsWithDrr(const Eigen::Isometry3d& T_world_from_ct);
   /// View v's image at pyramid `level` whose window variances weigh its VLNC windows (weighWindowsWithDrr), or null
   /// when the X-ray's own do.
@@ -228,6 +229,10 @@ class RegistrationCase {
   Status checkViewLevel(std::size_t v, int level) const;
   /// The ROI statistics of view v at (level, window), computed on first use.
   Result<const DynamicRoiSelector*> selector(std::size_t v, int level, int windowSize);
+  /// The full-resolution DRR of every view at T_world_from_ct (the case's exact renderer, views in parallel), or the
+  /// previous call's when T_world_from_ct is the same pose: a stage's haze removal and DRR window weights share them.
+  /// `rendered` gets the DRRs rendered (0 when kept). The pointer holds until the next call. Fails naming the view.
+  Result<const std::vector<FloatImage>*> fullResolutionDrrs(const Eigen::Isometry3d& T_world_from_ct, int& rendered);
 
   std::shared_ptr<const DrrVolume> m_drrVolume;
   std::shared_ptr<const DrrRenderer> m_renderer;
@@ -243,6 +248,8 @@ class RegistrationCase {
   std::optional<CutFaceRayMask> m_cutFaces;  ///< the CT's cut faces with the margin; none when it is off
   double m_viewRendererSetup_s = 0.0;
   std::vector<View> m_views;
+  std::optional<Eigen::Isometry3d> m_fullDrrPose;  ///< the pose of m_fullDrrs (fullResolutionDrrs)
+  std::vector<FloatImage> m_fullDrrs;              ///< every view's full-resolution DRR at m_fullDrrPose
   std::optional<BoneSurface> m_bone;
   Eigen::Vector3d m_centre_ct_mm = Eigen::Vector3d::Zero();
   double m_boneRadius_mm = 0.0;

@@ -27,7 +27,7 @@ fct::test::PreparedCase noisyPhantom() {
 
 }  // namespace
 
-TEST(RegistrationCase, WeighWindowsWithDrrKeepsEachViewsDrrPyramidUntilTheXraysAreRestored) {
+TEST(RegistrationCase, WeighWindowsWithDrrKeepsEachViewsDrrPyramidUntilRestoredAndSharesTheHazeRemovalsDrrs) {
   fct::test::PreparedCase p = noisyPhantom();
   fct::RegistrationCase& rc = p.registrationCase;
   const Eigen::Isometry3d& T = p.simulated.T_truth;
@@ -53,6 +53,20 @@ TEST(RegistrationCase, WeighWindowsWithDrrKeepsEachViewsDrrPyramidUntilTheXraysA
   EXPECT_EQ(rc.windowWeightImage(0, -1), nullptr);
   ASSERT_TRUE(rc.restorePreparedXrays().ok());
   for (std::size_t v = 0; v < rc.viewCount(); ++v) EXPECT_EQ(rc.windowWeightImage(v, 0), nullptr);
+
+  // A haze removal at a pose renders its DRRs; window weights at the same pose then reuse them, at another render.
+  auto removed = rc.removeHaze(T, 20.0);
+  ASSERT_TRUE(removed.ok()) << removed.error();
+  EXPECT_EQ(removed.value().drrs, 0) << "the weights' DRRs at the same pose";
+  Eigen::Isometry3d moved = T;
+  moved.translation() += Eigen::Vector3d(1.0, 0.0, 0.0);
+  auto atMoved = rc.removeHaze(moved, 20.0);
+  ASSERT_TRUE(atMoved.ok()) << atMoved.error();
+  EXPECT_EQ(atMoved.value().drrs, 3);
+  auto shared = rc.weighWindowsWithDrr(moved);
+  ASSERT_TRUE(shared.ok()) << shared.error();
+  EXPECT_EQ(shared.value(), 0) << "the haze removal's DRRs at the same pose";
+  EXPECT_EQ(rc.windowWeightImage(1, 0)->pixels, rc.renderer().render(rc.camera(1), moved, 0).value().pixels);
 }
 
 TEST(Registration, AStageWithDrrWindowWeightsRendersThemAtItsStartAndTheNextRunDropsThem) {
