@@ -492,26 +492,26 @@ Result<RegistrationResult> Registration::run(RegistrationCase& registrationCase,
         if (!rebuilt) return fail(rebuilt.error());
       }
     }
+    // The haze removal and the DRR window weights change what the stage compares: its objectives (and the later
+    // stages') are made again once, after both.
+    const Eigen::Isometry3d T_stageStart = registrationCase.poseTransform(current);
+    bool remake = false;
     if (stage.hazeSigma_mm > 0.0) {
-      const Eigen::Isometry3d T_haze = registrationCase.poseTransform(current);
-      auto removed = registrationCase.removeHaze(T_haze, stage.hazeSigma_mm);
+      auto removed = registrationCase.removeHaze(T_stageStart, stage.hazeSigma_mm);
       if (!removed) return fail(fmt::format("stage '{}': {}", stage.name, removed.error()));
       stageStart.haze = removed.value();
       stageStart.preSearchDrrs += removed.value().drrs;
-      if (removed.value().viewsCorrected > 0) {  // the X-rays changed: the stages from here on select their pixels again
-        const Status rebuilt = remakeObjectivesFrom(registrationCase, schedule, i, options.ablation, useViewRenderers,
-                                                    T_haze, objectives.value(), T_objectives);
-        if (!rebuilt) return fail(rebuilt.error());
-      }
+      remake = removed.value().viewsCorrected > 0;  // the X-rays changed: select the pixels again
     }
     if (stage.metric == SimilarityMetric::Vlnc && stage.vlncWeights == VlncWeightSource::Drr) {
-      const Eigen::Isometry3d T_weights = registrationCase.poseTransform(current);
-      auto weighed = registrationCase.weighWindowsWithDrr(T_weights);
+      auto weighed = registrationCase.weighWindowsWithDrr(T_stageStart);
       if (!weighed) return fail(fmt::format("stage '{}': {}", stage.name, weighed.error()));
       stageStart.preSearchDrrs += weighed.value();
-      // The weights changed: the stages from here on make their similarities again.
+      remake = true;
+    }
+    if (remake) {
       const Status rebuilt = remakeObjectivesFrom(registrationCase, schedule, i, options.ablation, useViewRenderers,
-                                                  T_weights, objectives.value(), T_objectives);
+                                                  T_stageStart, objectives.value(), T_objectives);
       if (!rebuilt) return fail(rebuilt.error());
     }
     if (stage.shiftPrealign) {

@@ -240,8 +240,8 @@ const FloatImage* RegistrationCase::windowWeightImage(std::size_t v, int level) 
 }
 
 Status RegistrationCase::restorePreparedXrays() {
-  for (View& view : m_views) view.windowWeights.reset();
   for (View& view : m_views) {
+    view.windowWeights.reset();
     if (!view.preparedImage) continue;
     auto pyramid = XrayPyramid::build(*view.preparedImage, view.prepared.pyramid.level(0).mask, view.camera,
                                       levelCount());
