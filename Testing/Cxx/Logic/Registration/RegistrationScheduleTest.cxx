@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "Base/JsonDocument.h"
@@ -107,10 +108,38 @@ TEST(RegistrationSchedule, HazeRemovalIsReadAndWrittenOnlyWhereItIsOn) {
   const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
   ASSERT_TRUE(again.ok()) << again.error();
   EXPECT_EQ(again.value().toJson(), json);
-  const auto clinical = RegistrationSchedule::builtin("clinical").value().toJson();
-  for (const auto& stage : clinical["stages"]) {
+  const auto paper = RegistrationSchedule::builtin("paper").value().toJson();
+  for (const auto& stage : paper["stages"]) {
     EXPECT_FALSE(stage.contains("haze_sigma_mm")) << "off by default, and off is not written";
   }
+  const auto clinical = RegistrationSchedule::builtin("clinical").value();
+  EXPECT_EQ(clinical.stages.back().hazeSigma_mm, 15.0) << "the default removes the haze before its last stage";
+  EXPECT_EQ(clinical.stages.back().vlncWeights, fct::VlncWeightSource::Drr) << "and weighs that stage's windows by a DRR";
+  EXPECT_EQ(clinical.stages.front().hazeSigma_mm, 0.0) << "its NCC stage compares the X-rays as prepared";
+}
+
+// docs/evaluation.md re-runs its ablations with the preset files of docs/evaluation/presets/: each must stay a valid
+// schedule, and the two that the page defines as the default less its last stage's haze removal and/or DRR window
+// weights must stay exactly that.
+TEST(RegistrationSchedule, TheEvaluationsPresetFilesAreValidAndTheHazeAblationsDifferFromTheDefaultOnlyWhereNamed) {
+  const auto presetDir = fct::test::scriptPath("demo.sh").parent_path().parent_path() / "docs" / "evaluation" / "presets";
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(presetDir)) {
+    const auto parsed = RegistrationSchedule::resolve(entry.path().string());
+    EXPECT_TRUE(parsed.ok()) << entry.path() << ": " << parsed.error();
+    ++files;
+  }
+  EXPECT_GE(files, 2) << presetDir;
+  auto expected = RegistrationSchedule::builtin("clinical").value().toJson()["stages"];
+  ASSERT_EQ(expected.back()["weights"], "drr");
+  expected.back().erase("weights");
+  const auto dehaze = RegistrationSchedule::resolve((presetDir / "clinical-dehaze.json").string());
+  ASSERT_TRUE(dehaze.ok()) << dehaze.error();
+  EXPECT_EQ(dehaze.value().toJson()["stages"], expected) << "clinical-dehaze is clinical without its DRR weights";
+  expected.back().erase("haze_sigma_mm");
+  const auto without = RegistrationSchedule::resolve((presetDir / "clinical-without-haze-removal.json").string());
+  ASSERT_TRUE(without.ok()) << without.error();
+  EXPECT_EQ(without.value().toJson()["stages"], expected) << "clinical without its haze removal and DRR weights";
 }
 
 TEST(RegistrationSchedule, DrrWindowWeightsAreReadAndWrittenOnlyWhereTheyAreAskedFor) {
