@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "Drr/DrrRayGeometry.h"
@@ -73,9 +74,12 @@ Result<CutFaceRayMask> CutFaceRayMask::create(const DrrVolume& volume, double ma
     face->footprint = sliceFootprint(volume, k, grow);
     face->iMin = mask.m_dims.x();
     face->jMin = mask.m_dims.y();
+    face->blockCols = (mask.m_dims.x() + kBlock - 1) / kBlock;
+    face->blocks.assign(static_cast<std::size_t>(face->blockCols) * ((mask.m_dims.y() + kBlock - 1) / kBlock), 0);
     for (int j = 0; j < mask.m_dims.y(); ++j)
       for (int i = 0; i < mask.m_dims.x(); ++i) {
         if (!face->footprint[static_cast<std::size_t>(j) * mask.m_dims.x() + i]) continue;
+        face->blocks[static_cast<std::size_t>(j / kBlock) * face->blockCols + i / kBlock] = 1;
         face->iMin = std::min(face->iMin, i);
         face->iMax = std::max(face->iMax, i);
         face->jMin = std::min(face->jMin, j);
@@ -97,11 +101,29 @@ bool CutFaceRayMask::crosses(const Face& face, const Eigen::Vector3d& a, const E
   int qFirst = 0, qLast = samples - 1;
   narrowToSlab(a.x(), d.x(), t0, step, face.iMin - 1.0, face.iMax + 1.0, qFirst, qLast);
   narrowToSlab(a.y(), d.y(), t0, step, face.jMin - 1.0, face.jMax + 1.0, qFirst, qLast);
-  for (int q = qFirst; q <= qLast; ++q) {
+  const int lastBlockI = (ni - 1) / kBlock, lastBlockJ = (nj - 1) / kBlock;
+  for (int q = qFirst; q <= qLast;) {
     const Eigen::Vector3d p = a + d * (t0 + (t1 - t0) * q / (samples - 1));
     const int i = std::clamp(nearest(p.x()), 0, ni - 1);
     const int j = std::clamp(nearest(p.y()), 0, nj - 1);
-    if (face.footprint[static_cast<std::size_t>(j) * ni + i]) return true;
+    const int bi = i / kBlock, bj = j / kBlock;
+    if (face.blocks[static_cast<std::size_t>(bj) * face.blockCols + bi]) {
+      if (face.footprint[static_cast<std::size_t>(j) * ni + i]) return true;
+      ++q;
+      continue;
+    }
+    // An empty block: every sample whose coordinates round into it is off the footprint. Jump to the last sample
+    // that is surely still in it (its range shrunk by kInside against rounding; clamped blocks reach on without end),
+    // then on by one.
+    constexpr double kInside = 1e-6;
+    double qExit = std::numeric_limits<double>::infinity();
+    const auto exitAlong = [&](double start, double slope, int block, int lastBlock) {
+      if (slope > 0.0 && block < lastBlock) qExit = std::min(qExit, ((block + 1) * kBlock - 0.5 - kInside - start) / slope);
+      if (slope < 0.0 && block > 0) qExit = std::min(qExit, (block * kBlock - 0.5 + kInside - start) / slope);
+    };
+    exitAlong(a.x() + d.x() * t0, d.x() * step, bi, lastBlockI);
+    exitAlong(a.y() + d.y() * t0, d.y() * step, bj, lastBlockJ);
+    q = qExit >= qLast ? qLast + 1 : std::max(q, static_cast<int>(std::floor(qExit))) + 1;
   }
   return false;
 }

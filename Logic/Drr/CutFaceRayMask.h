@@ -4,7 +4,8 @@
 // patient beyond a face is taken to continue the face's own cross-section: the footprint of an end slice is its
 // tissue (above −500 HU) grown in-plane by the margin; a face with no tissue cuts nothing. A pixel is excluded when
 // its ray, within the margin of an end face along k or beyond it, passes over that face's footprint. The footprints
-// are made once (create); each mask then only walks the rays, and only over the footprints' bounding boxes.
+// are made once (create); each mask then only walks the rays, only over the footprints' bounding boxes, and steps over
+// the kBlock x kBlock voxel blocks that hold no footprint voxel in one jump.
 
 #include <Eigen/Geometry>
 
@@ -30,10 +31,15 @@ class CutFaceRayMask {
   ValidMask compute(const Camera& camera, const Eigen::Isometry3d& T_world_from_ct) const;
 
  private:
-  /// The grown footprint of one end slice, in voxel indices (i fastest), and its bounding box (empty: iMax < iMin).
+  /// Side of the square voxel blocks a ray steps over when they hold no footprint voxel.
+  static constexpr int kBlock = 8;
+  /// The grown footprint of one end slice, in voxel indices (i fastest), its bounding box (empty: iMax < iMin) and
+  /// its kBlock x kBlock blocks (1: the block holds a footprint voxel; block (bi, bj) at bj * blockCols + bi).
   struct Face {
     std::vector<std::uint8_t> footprint;
     int iMin = 0, iMax = -1, jMin = 0, jMax = -1;
+    std::vector<std::uint8_t> blocks;
+    int blockCols = 0;
   };
   /// True when the ray a + t·d, t in [t0, t1] (ijk), passes over a pixel of `face` (sampled every half voxel).
   bool crosses(const Face& face, const Eigen::Vector3d& a, const Eigen::Vector3d& d, double t0, double t1) const;

@@ -1,6 +1,9 @@
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
 #include <limits>
 
 #include "Drr/CutFaceRayMask.h"
@@ -20,6 +23,16 @@ fct::DrrVolume cylinderCt(bool airAtTheEnds) {
         const Eigen::Vector3d p = ct.lpsFromIjk(Eigen::Vector3d(i, j, k));
         if (p.head<2>().norm() < 20.0) ct.at(i, j, k) = 0.0f;
       }
+  return fct::DrrVolume::create(ct).value();
+}
+
+/// A 1 mm CT of 64 x 64 x 10 voxels centred on the world origin: air with a tissue rod one voxel thick along k at
+/// voxel column (i, j).
+fct::DrrVolume rodCt(int i, int j) {
+  fct::Volume ct = fct::Volume::create(Eigen::Vector3i(64, 64, 10), Eigen::Vector3d(1, 1, 1),
+                                       Eigen::Vector3d(-31.5, -31.5, -4.5), Eigen::Matrix3d::Identity(), -1000.0f)
+                       .value();
+  for (int k = 0; k < 10; ++k) ct.at(i, j, k) = 0.0f;
   return fct::DrrVolume::create(ct).value();
 }
 
@@ -51,6 +64,29 @@ TEST(CutFaceRayMask, LeavesOutRaysOverThePatientBeyondACutFace) {
   EXPECT_FALSE(validAt(mask, camera, Eigen::Vector3d(0, 0, 35)));       // beyond it, over the cylinder
   EXPECT_FALSE(validAt(mask, camera, Eigen::Vector3d(0, 0, -35)));      // beyond the bottom face
   EXPECT_TRUE(validAt(mask, camera, Eigen::Vector3d(40, 0, 35)));       // beside the cylinder's footprint
+}
+
+TEST(CutFaceRayMask, FindsAOneVoxelFootprintFromEveryDirectionWhereverItSitsInItsBlock) {
+  // Rays reach the rod across empty voxel blocks, which the mask steps over in one jump: it must land on the rod all
+  // the same, at a block's first, middle and last voxel, seen along i, along j and obliquely.
+  fct::StandardViewOptions options;
+  options.count = 3;
+  options.cols = options.rows = 128;
+  options.pixelSpacing_mm = 1.0;
+  const auto views = fct::StandardViews::build(Eigen::Vector3d::Zero(), options).value();
+  for (const auto& [i, j] : {std::pair{8, 8}, std::pair{47, 12}, std::pair{20, 55}, std::pair{63, 0}}) {
+    const fct::DrrVolume volume = rodCt(i, j);
+    auto cutFaces = fct::CutFaceRayMask::create(volume, 0.0);
+    ASSERT_TRUE(cutFaces.ok()) << cutFaces.error();
+    const Eigen::Vector3d rod_world_mm = volume.values().lpsFromIjk(Eigen::Vector3d(i, j, 0));
+    for (const auto& view : views) {
+      const fct::ValidMask mask = cutFaces.value().compute(view.camera, Eigen::Isometry3d::Identity());
+      const std::string where = fmt::format("rod at ({}, {}), view {}", i, j, view.name);
+      EXPECT_FALSE(validAt(mask, view.camera, rod_world_mm + Eigen::Vector3d(0, 0, -20))) << where;  // over it, beyond
+      EXPECT_TRUE(validAt(mask, view.camera, rod_world_mm + Eigen::Vector3d(0, 0, 3))) << where;     // inside the slab
+      EXPECT_GT(mask.validCount(), static_cast<std::size_t>(0.9 * 128 * 128)) << where;  // a rod hides only a strip
+    }
+  }
 }
 
 TEST(CutFaceRayMask, KeepsEveryRayWhenTheEndSlicesHoldNoPatient) {
