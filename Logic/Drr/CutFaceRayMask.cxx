@@ -101,7 +101,18 @@ bool CutFaceRayMask::crosses(const Face& face, const Eigen::Vector3d& a, const E
   int qFirst = 0, qLast = samples - 1;
   narrowToSlab(a.x(), d.x(), t0, step, face.iMin - 1.0, face.iMax + 1.0, qFirst, qLast);
   narrowToSlab(a.y(), d.y(), t0, step, face.jMin - 1.0, face.jMax + 1.0, qFirst, qLast);
+  // An empty block: every sample whose coordinates round into it is off the footprint, so the walk jumps to the last
+  // sample surely still in it (its range shrunk by kInside against rounding; clamped blocks reach on without end),
+  // then on by one. A sample's coordinate along an axis is start + slope * q.
+  constexpr double kInside = 1e-6;
   const int lastBlockI = (ni - 1) / kBlock, lastBlockJ = (nj - 1) / kBlock;
+  const double startI = a.x() + d.x() * t0, slopeI = d.x() * step;
+  const double startJ = a.y() + d.y() * t0, slopeJ = d.y() * step;
+  const auto exitAlong = [](double start, double slope, int block, int lastBlock) {
+    if (slope > 0.0 && block < lastBlock) return ((block + 1) * kBlock - 0.5 - kInside - start) / slope;
+    if (slope < 0.0 && block > 0) return (block * kBlock - 0.5 + kInside - start) / slope;
+    return std::numeric_limits<double>::infinity();
+  };
   for (int q = qFirst; q <= qLast;) {
     const Eigen::Vector3d p = a + d * (t0 + (t1 - t0) * q / (samples - 1));
     const int i = std::clamp(nearest(p.x()), 0, ni - 1);
@@ -112,17 +123,7 @@ bool CutFaceRayMask::crosses(const Face& face, const Eigen::Vector3d& a, const E
       ++q;
       continue;
     }
-    // An empty block: every sample whose coordinates round into it is off the footprint. Jump to the last sample
-    // that is surely still in it (its range shrunk by kInside against rounding; clamped blocks reach on without end),
-    // then on by one.
-    constexpr double kInside = 1e-6;
-    double qExit = std::numeric_limits<double>::infinity();
-    const auto exitAlong = [&](double start, double slope, int block, int lastBlock) {
-      if (slope > 0.0 && block < lastBlock) qExit = std::min(qExit, ((block + 1) * kBlock - 0.5 - kInside - start) / slope);
-      if (slope < 0.0 && block > 0) qExit = std::min(qExit, (block * kBlock - 0.5 + kInside - start) / slope);
-    };
-    exitAlong(a.x() + d.x() * t0, d.x() * step, bi, lastBlockI);
-    exitAlong(a.y() + d.y() * t0, d.y() * step, bj, lastBlockJ);
+    const double qExit = std::min(exitAlong(startI, slopeI, bi, lastBlockI), exitAlong(startJ, slopeJ, bj, lastBlockJ));
     q = qExit >= qLast ? qLast + 1 : std::max(q, static_cast<int>(std::floor(qExit))) + 1;
   }
   return false;

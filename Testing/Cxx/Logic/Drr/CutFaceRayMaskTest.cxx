@@ -2,9 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
-#include <limits>
 
 #include "Drr/CutFaceRayMask.h"
 #include "Simulation/StandardViews.h"
