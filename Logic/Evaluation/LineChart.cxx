@@ -176,7 +176,8 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
   centredText(image, spec.xLabel, (left + right) / 2, spec.height_px - 12, kTextScale);
   verticalText(image, spec.yLabel, 8, (top + bottom) / 2);
 
-  // Series, clipped to the plot area; `drawn` marks their pixels (plot-area coordinates) for the legend's placement.
+  // Series, their lines clipped to the plot area; `drawn` marks their pixels (plot-area coordinates) for the
+  // legend's placement.
   const cv::Rect plotArea(left, top, right - left + 1, bottom - top + 1);
   cv::Mat plot = image(plotArea);
   cv::Mat drawn(plot.size(), CV_8U, cv::Scalar(0));
@@ -197,7 +198,15 @@ Result<RgbImage> drawUnguarded(const ChartSpec& spec) {
         cv::line(plot, previous - origin, p - origin, bgr(n), 2, cv::LINE_AA);
         cv::line(drawn, previous - origin, p - origin, cv::Scalar(255), 2);
       }
-      drawSeriesMarker(plot, p - origin, n);
+      // A point on the axes' range shows its whole marker, over the frame where it sits on an axis limit (a 100 %
+      // success rate); a point beyond the range is clipped to the plot area with its line.
+      const bool onRange = points[i].second >= spec.yMin && points[i].second <= yHi && points[i].first >= xLo &&
+                           points[i].first <= xHi;
+      if (onRange) {
+        drawSeriesMarker(image, p, n);
+      } else {
+        drawSeriesMarker(plot, p - origin, n);
+      }
       cv::circle(drawn, p - origin, 6, cv::Scalar(255), cv::FILLED);
     }
   }

@@ -2,8 +2,9 @@
 // LineChart: a small 2D chart drawn with OpenCV into an RGB image (white background, framed plot area, x and y axes
 // with ticks at "nice" steps and numeric or category tick labels, axis labels, a title and a legend in the corner of
 // the plot area that hides the fewest series pixels), for the evaluation reports. Each series is a polyline with
-// markers (or markers only); NaN points are skipped. Series n has colour n of a 7-colour cycle and, from the 8th series
-// on, a marker shape of its own for each further cycle, so that no two of the first 28 series look alike.
+// markers (or markers only); NaN points are skipped, and a point on an axis limit shows its whole marker. Series n has
+// colour n of a 7-colour cycle and, from the 8th series on, a marker shape of its own for each further cycle, so that
+// no two of the first 28 series look alike.
 
 #include <array>
 #include <cstdint>

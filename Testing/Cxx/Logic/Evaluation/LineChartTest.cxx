@@ -91,6 +91,23 @@ TEST(LineChart, CategoryAxisAcceptsIndicesOfItsCategories) {
   EXPECT_FALSE(fct::LineChart::draw(spec).ok());
 }
 
+TEST(LineChart, APointOnTheTopOfTheAxisShowsItsWholeMarkerOverTheFrame) {
+  // A 100 % success rate on an axis that ends at 100: the discs (radius 4) reach above the frame's top row, 50.
+  fct::ChartSpec spec;
+  spec.categories = {"ideal", "realistic", "bad"};
+  spec.series.push_back({"pelvis", {0, 1, 2}, {100, 100, 100}, false});
+  spec.yMaxAtLeast = 100.0;
+  const auto image = fct::LineChart::draw(spec);
+  ASSERT_TRUE(image.ok()) << image.error();
+  int aboveFrame = 0;
+  for (int row = 44; row < 50; ++row) {
+    for (int col = 80; col < spec.width_px - 20; ++col) {
+      aboveFrame += image.value().at(col, row) == fct::LineChart::seriesColour(0) ? 1 : 0;
+    }
+  }
+  EXPECT_GE(aboveFrame, 3 * 3);  // a few pixels of each of the three discs
+}
+
 TEST(LineChart, BadSpecsAreRejected) {
   fct::ChartSpec spec;
   EXPECT_FALSE(fct::LineChart::draw(spec).ok());  // no series
