@@ -52,7 +52,9 @@ std::string readText(const std::filesystem::path& path) {
 
 std::filesystem::path cliPath() { return FCT_CLI_PATH; }
 
-std::filesystem::path scriptPath(const std::string& name) { return std::filesystem::path(FCT_SCRIPT_DIR) / name; }
+std::filesystem::path sourcePath(const std::string& relative) { return std::filesystem::path(FCT_SOURCE_DIR) / relative; }
+
+std::filesystem::path scriptPath(const std::string& name) { return sourcePath("scripts") / name; }
 
 ProcessResult runCommand(const std::string& commandLine) {
   // Not scratchDir(): that would empty the calling test's folder before every command.

@@ -21,6 +21,8 @@ std::filesystem::path workDir();
 std::string readText(const std::filesystem::path& path);
 /// Path of the built `fluoroct` command-line program.
 std::filesystem::path cliPath();
+/// Path of a file or folder in the source tree, relative to its top, e.g. sourcePath("docs/evaluation/presets").
+std::filesystem::path sourcePath(const std::string& relative);
 /// Path of a script in the repository's scripts/ folder, e.g. scriptPath("study-parallel.sh").
 std::filesystem::path scriptPath(const std::string& name);
 

@@ -122,7 +122,7 @@ TEST(RegistrationSchedule, HazeRemovalIsReadAndWrittenOnlyWhereItIsOn) {
 // schedule, and the two that the page defines as the default less its last stage's haze removal and/or DRR window
 // weights must stay exactly that.
 TEST(RegistrationSchedule, TheEvaluationsPresetFilesAreValidAndTheHazeAblationsDifferFromTheDefaultOnlyWhereNamed) {
-  const auto presetDir = fct::test::scriptPath("demo.sh").parent_path().parent_path() / "docs" / "evaluation" / "presets";
+  const auto presetDir = fct::test::sourcePath("docs/evaluation/presets");
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(presetDir)) {
     const auto parsed = RegistrationSchedule::resolve(entry.path().string());
