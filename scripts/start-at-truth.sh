@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The bias of the optimum: registration started at the true pose of Table 2's trials (the studies' X-rays: continuous
 # patient, 80 kVp spectrum, scatter haze, noise, PSF, vignetting; the ideal scenario by default: no tools, the original
-# CT; realistic and bad: K-wires and screws not in the CT, and the CT of 2.4 or 4.2 mm slices the case writes), with
-# one or more presets.
+# CT; realistic and bad: K-wires and screws not in the CT, and the CT of 2.4 or 4.2 mm slices the case writes where
+# the scenario's slices differ from the CT's own, as the pelvis's realistic 3 mm ones do not), with one or more presets.
 # Writes each trial once as a case (`fluoroct evaluate --write-trial`, kept in the work folder and reused), registers
 # it from its truth (`fluoroct register --init truth_pose.json --cut-face-margin-mm 5` with the trial's seed and CT, as
 # the study does) and prints, per preset and CT, the mean and largest final error (mean bone-surface distance to the
