@@ -110,6 +110,51 @@ Result<DrrVolume> DrrVolume::coarsened(const Eigen::Vector3i& blockSize_ijk) con
   return volume;
 }
 
+DrrVolume DrrVolume::sliceAveragesDeconvolved() const {
+  DrrVolume volume;
+  volume.m_values = m_values;
+  volume.m_options = m_options;
+  volume.m_T_ct_from_ijk = m_T_ct_from_ijk;
+  volume.m_T_ijk_from_ct = m_T_ijk_from_ct;
+  // The tridiagonal system is the same for every column: Thomas's forward factors are computed once, then every
+  // row of i values is swept forward and back along k (rows of one j in parallel; each row is contiguous).
+  const int nk = dims().z();
+  constexpr double kNeighbour = 1.0 / 8.0;
+  std::vector<double> upper(nk), pivotInverse(nk);
+  for (int k = 0; k < nk; ++k) {
+    const double diagonal = 0.75 + (k == 0 ? kNeighbour : 0.0) + (k == nk - 1 ? kNeighbour : 0.0);
+    const double pivot = diagonal - (k > 0 ? kNeighbour * upper[k - 1] : 0.0);
+    pivotInverse[k] = 1.0 / pivot;
+    upper[k] = kNeighbour / pivot;
+  }
+  const int ni = dims().x();
+  tbb::parallel_for(0, dims().y(), [&](int j) {
+    std::vector<double> solved(static_cast<std::size_t>(ni) * nk);
+    for (int k = 0; k < nk; ++k) {
+      const float* row = data() + m_values.offset(0, j, k);
+      double* out = solved.data() + static_cast<std::size_t>(k) * ni;
+      if (k == 0) {
+        for (int i = 0; i < ni; ++i) out[i] = row[i] * pivotInverse[0];
+        continue;
+      }
+      const double* previous = out - ni;
+      for (int i = 0; i < ni; ++i) out[i] = (row[i] - kNeighbour * previous[i]) * pivotInverse[k];
+    }
+    for (int k = nk - 2; k >= 0; --k) {
+      double* out = solved.data() + static_cast<std::size_t>(k) * ni;
+      const double* next = out + ni;
+      for (int i = 0; i < ni; ++i) out[i] -= upper[k] * next[i];
+    }
+    for (int k = 0; k < nk; ++k) {
+      float* row = &volume.m_values.at(0, j, k);
+      const double* out = solved.data() + static_cast<std::size_t>(k) * ni;
+      for (int i = 0; i < ni; ++i) row[i] = static_cast<float>(out[i]);
+    }
+  });
+  volume.findContentBox();
+  return volume;
+}
+
 const float* DrrVolume::valuesJFastest() const {
   std::call_once(m_jFastest->made, [this] {
     const Eigen::Vector3i& n = dims();

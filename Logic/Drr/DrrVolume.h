@@ -3,6 +3,7 @@
 // (attenuation µ in 1/mm, or the raw voxel value), on the CT's voxel grid, with the CT index <-> CT mm maps.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <Eigen/Geometry>
 #include <memory>
 #include <mutex>
@@ -32,6 +33,17 @@ struct DrrValueOptions {
   double waterAttenuation_per_mm = kWaterAttenuationAt60keV_per_mm;  ///< µ_water used by Attenuation
 };
 
+/// What a CT slice's value stands for along the slice axis (k), for a renderer that interpolates between slices.
+enum class CtSliceModel {
+  /// The patient's value at the slice's centre (the values are interpolated as they are).
+  Samples,
+  /// The patient's average over the slice's thickness, a box of one slice spacing (contiguous slices, as a CT
+  /// reconstructs them): the values are first re-expressed so that their linear interpolant has these averages. Taken
+  /// only for a CT of thick slices (DrrVolume::hasThickSlices); near-cubic voxels, as a resampled volume has, are read
+  /// as samples (measured: docs/evaluation.md, "Slice profile").
+  SlabAverages,
+};
+
 /// The per-voxel DRR values of a CT (float, i fastest) and its geometry. Voxel (i,j,k) is the box of one spacing
 /// around its centre, so the volume's extent in index space is [-0.5, dims - 0.5] per axis.
 class DrrVolume {
@@ -50,6 +62,22 @@ class DrrVolume {
   /// A line integral through the result equals one through the original CT blurred by the block (less traversal
   /// work: the coarse pyramid levels of registration use it). Fails on a block size below 1.
   Result<DrrVolume> coarsened(const Eigen::Vector3i& blockSize_ijk) const;
+
+  /// The values re-expressed for a CT whose slices are averages over their thickness (CtSliceModel::SlabAverages):
+  /// per (i,j) column, the values c' whose linear interpolant along k averages, over each slice's box of one spacing,
+  /// to that slice's value c, i.e. the solution of c_k = c'_{k-1} / 8 + 3 c'_k / 4 + c'_{k+1} / 8 with the outer
+  /// slices' neighbours mirrored (the edge value held to the box face, as the trilinear renderer holds it). A
+  /// trilinear DRR of the result then integrates the same slice averages as the CT but no longer blurs each slab edge
+  /// over two slices. Sharpens along k only (values may dip below 0 beside an edge); same options and geometry.
+  DrrVolume sliceAveragesDeconvolved() const;
+  /// Slices this many times the larger in-plane spacing, or thicker, count as thick (hasThickSlices).
+  static constexpr double kThickSliceRatio = 1.5;
+  /// True when the slice spacing (k) is at least kThickSliceRatio times the larger of the i and j spacings: a scan's
+  /// own thick slices, each an average over its thickness, rather than a near-cubic resampled grid.
+  bool hasThickSlices() const {
+    const Eigen::Vector3d& s = m_values.spacing_mm();
+    return s.z() >= kThickSliceRatio * std::max(s.x(), s.y());
+  }
 
   /// Parses "attenuation" or "raw"; the error lists the accepted names.
   static Result<DrrValueKind> parseValueKind(std::string_view name);

@@ -318,32 +318,42 @@ Eigen::Vector3i RegistrationCase::ctBlockSize(std::size_t v, int level, const Ei
 
 Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int level,
                                                            const Eigen::Isometry3d& T_world_from_ct, int pixelStride,
-                                                           std::optional<DrrMethod> method, double rayCastStep_voxels) {
+                                                           std::optional<DrrMethod> method, double rayCastStep_voxels,
+                                                           CtSliceModel slices) {
   if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
+  if (!m_drrVolume->hasThickSlices()) slices = CtSliceModel::Samples;
   const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct, std::max(1, pixelStride));
   const DrrMethod exactMethod = method.value_or(exactRendererOptions(m_drrOptions).method);
-  if ((block.array() == 1).all()) return methodRenderer(exactMethod, rayCastStep_voxels);
+  if ((block.array() == 1).all()) return methodRenderer(exactMethod, rayCastStep_voxels, slices);
   if (exactMethod == DrrMethod::Transgraph) return fail("a coarsened CT is rendered with siddon or raycast, not transgraph");
-  return keptRenderer(exactMethod, block, rayCastStep_voxels);
+  return keptRenderer(exactMethod, block, rayCastStep_voxels, slices);
 }
 
-Result<const DrrRenderer*> RegistrationCase::methodRenderer(DrrMethod method, double rayCastStep_voxels) {
-  if (method == exactRendererOptions(m_drrOptions).method && rayCastStep_voxels == 0.0) return m_renderer.get();
+Result<const DrrRenderer*> RegistrationCase::methodRenderer(DrrMethod method, double rayCastStep_voxels,
+                                                            CtSliceModel slices) {
+  if (!m_drrVolume->hasThickSlices()) slices = CtSliceModel::Samples;
+  if (method == exactRendererOptions(m_drrOptions).method && rayCastStep_voxels == 0.0 &&
+      slices == CtSliceModel::Samples) {
+    return m_renderer.get();
+  }
   if (method == DrrMethod::Transgraph) return fail("the transgraph is built per view, not as a CT renderer");
-  return keptRenderer(method, Eigen::Vector3i::Ones(), rayCastStep_voxels);
+  return keptRenderer(method, Eigen::Vector3i::Ones(), rayCastStep_voxels, slices);
 }
 
 Result<const DrrRenderer*> RegistrationCase::keptRenderer(DrrMethod method, const Eigen::Vector3i& block,
-                                                          double rayCastStep_voxels) {
+                                                          double rayCastStep_voxels, CtSliceModel slices) {
   if (!(rayCastStep_voxels >= 0.0 && rayCastStep_voxels <= 10.0)) {  // also NaN
     return fail(fmt::format("ray-cast step must be 0 (the default) to 10 voxels, got {}", rayCastStep_voxels));
   }
-  const RendererKey key{method, {block.x(), block.y(), block.z()}, rayCastStep_voxels};
+  const RendererKey key{method, {block.x(), block.y(), block.z()}, rayCastStep_voxels, slices};
   auto found = m_keptRenderers.find(key);
   if (found != m_keptRenderers.end()) return found->second.get();
-  std::shared_ptr<const DrrVolume> volume = m_drrVolume;
+  if (slices == CtSliceModel::SlabAverages && !m_sliceAveragesVolume) {
+    m_sliceAveragesVolume = std::make_shared<const DrrVolume>(m_drrVolume->sliceAveragesDeconvolved());
+  }
+  std::shared_ptr<const DrrVolume> volume = slices == CtSliceModel::SlabAverages ? m_sliceAveragesVolume : m_drrVolume;
   if ((block.array() != 1).any()) {
-    auto coarse = m_drrVolume->coarsened(block);
+    auto coarse = volume->coarsened(block);
     if (!coarse) return fail(coarse.error());
     volume = std::make_shared<const DrrVolume>(std::move(coarse).value());
   }

@@ -98,15 +98,19 @@ class RegistrationCase {
   /// the rendered pixels are every pixelStride-th column and row of the level, so the footprint is that many pixels.
   /// Coarse CTs are made on first use and kept. Fails on a bad view or level.
   /// `method` (siddon or raycast) replaces renderer()'s method, e.g. for a stage that names its own DRR method, and
-  /// `rayCastStep_voxels` > 0 the ray-cast step (see methodRenderer()).
+  /// `rayCastStep_voxels` > 0 the ray-cast step and `slices` the CT's slice model (see methodRenderer()).
   Result<const DrrRenderer*> levelRenderer(std::size_t v, int level, const Eigen::Isometry3d& T_world_from_ct,
                                            int pixelStride = 1, std::optional<DrrMethod> method = std::nullopt,
-                                           double rayCastStep_voxels = 0.0);
+                                           double rayCastStep_voxels = 0.0,
+                                           CtSliceModel slices = CtSliceModel::Samples);
   /// The exact renderer of the full CT with `method` (siddon or raycast): renderer() when that is its method and
   /// `rayCastStep_voxels` is 0, else made on first use and kept. `rayCastStep_voxels` > 0 sets the ray-cast step to that
-  /// many voxels (a voxel: the cube root of the voxel volume); 0 keeps the case's step. Fails for transgraph (built per
-  /// view, not per method) and for a step outside 0 to 10 voxels.
-  Result<const DrrRenderer*> methodRenderer(DrrMethod method, double rayCastStep_voxels = 0.0);
+  /// many voxels (a voxel: the cube root of the voxel volume); 0 keeps the case's step. `slices` SlabAverages renders
+  /// a CT of thick slices (DrrVolume::hasThickSlices; others as samples) with its values deconvolved along them
+  /// (DrrVolume::sliceAveragesDeconvolved, made on first use and kept).
+  /// Fails for transgraph (built per view, not per method) and for a step outside 0 to 10 voxels.
+  Result<const DrrRenderer*> methodRenderer(DrrMethod method, double rayCastStep_voxels = 0.0,
+                                            CtSliceModel slices = CtSliceModel::Samples);
   /// The CT voxels per axis that levelRenderer() averages for view v at `level`: floor(pixel footprint / voxel
   /// spacing), at least 1, where the footprint is the level's smaller pixel side scaled to the depth of the rotation
   /// centre at T_world_from_ct (the pixel's size at the bone), times `pixelStride`. v and level must be valid
@@ -235,12 +239,15 @@ class RegistrationCase {
   Result<const std::vector<FloatImage>*> fullResolutionDrrs(const Eigen::Isometry3d& T_world_from_ct, int& rendered);
 
   std::shared_ptr<const DrrVolume> m_drrVolume;
+  std::shared_ptr<const DrrVolume> m_sliceAveragesVolume;  ///< m_drrVolume deconvolved along k, made on first use
   std::shared_ptr<const DrrRenderer> m_renderer;
   /// What identifies a kept renderer: method, CT block size (the full CT: 1, 1, 1) and ray-cast step in voxels (0: the
   /// case's step).
-  using RendererKey = std::tuple<DrrMethod, std::array<int, 3>, double>;
-  /// The renderer of `method` over the CT averaged in blocks of `block` voxels, made on first use and kept.
-  Result<const DrrRenderer*> keptRenderer(DrrMethod method, const Eigen::Vector3i& block, double rayCastStep_voxels);
+  using RendererKey = std::tuple<DrrMethod, std::array<int, 3>, double, CtSliceModel>;
+  /// The renderer of `method` over the CT (its slices read as `slices`) averaged in blocks of `block` voxels, made on
+  /// first use and kept.
+  Result<const DrrRenderer*> keptRenderer(DrrMethod method, const Eigen::Vector3i& block, double rayCastStep_voxels,
+                                          CtSliceModel slices);
 
   std::map<RendererKey, std::shared_ptr<const DrrRenderer>> m_keptRenderers;
   DrrRendererOptions m_drrOptions;

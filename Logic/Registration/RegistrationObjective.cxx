@@ -170,11 +170,11 @@ Result<RegistrationObjective> RegistrationObjective::create(RegistrationCase& re
     if (!tableRenderer && T_coarseCt_world_from_ct) {
       const int footprintStride = stage.metric == SimilarityMetric::Ncc ? stride : 1;
       auto levelRenderer = registrationCase.levelRenderer(v, level, *T_coarseCt_world_from_ct, footprintStride,
-                                                          stage.drrMethod, stage.drrStep_voxels);
+                                                          stage.drrMethod, stage.drrStep_voxels, stage.drrSlices);
       if (!levelRenderer) return fail(fmt::format("{}: {}", where(v), levelRenderer.error()));
       view.renderer = levelRenderer.value();
     } else if (stage.drrMethod) {
-      auto methodRenderer = registrationCase.methodRenderer(*stage.drrMethod, stage.drrStep_voxels);
+      auto methodRenderer = registrationCase.methodRenderer(*stage.drrMethod, stage.drrStep_voxels, stage.drrSlices);
       if (!methodRenderer) return fail(fmt::format("{}: {}", where(v), methodRenderer.error()));
       view.renderer = methodRenderer.value();
     }

@@ -28,6 +28,8 @@ constexpr NameTable<LocalSearchMethod, 2> kLocalMethods{
     {{"simplex", LocalSearchMethod::Simplex}, {"bobyqa", LocalSearchMethod::Bobyqa}}};
 /// The exact methods a stage may name in "drr" (the Transgraph is built per view and case, not per stage).
 constexpr NameTable<DrrMethod, 2> kStageDrrMethods{{{"siddon", DrrMethod::Siddon}, {"raycast", DrrMethod::RayCast}}};
+constexpr NameTable<CtSliceModel, 2> kCtSliceModels{
+    {{"samples", CtSliceModel::Samples}, {"slab_averages", CtSliceModel::SlabAverages}}};
 constexpr NameTable<VlncDomain, 2> kVlncDomains{
     {{"line_integral", VlncDomain::LineIntegral}, {"intensity", VlncDomain::Intensity}}};
 constexpr NameTable<VlncWeightSource, 2> kVlncWeightSources{
@@ -134,6 +136,13 @@ Result<RegistrationStage> readStage(const nlohmann::json& object, const std::str
       reader.rejectKey("drr_step_voxels", "applies only with \"drr\": \"raycast\"");
     } else if (!(stage.drrStep_voxels > 0.0 && stage.drrStep_voxels <= 10.0)) {
       reader.rejectKey("drr_step_voxels", fmt::format("is {}; use a step above 0 and at most 10 voxels", stage.drrStep_voxels));
+    }
+  }
+  if (reader.has("drr_slices")) {
+    stage.drrSlices = parseName(reader, "drr_slices", kCtSliceModels);
+    if (reader.ok() && stage.drrMethod != DrrMethod::RayCast) {
+      reader.rejectKey("drr_slices", "applies only with \"drr\": \"raycast\" (exact box voxels already average "
+                                     "each slice)");
     }
   }
 
@@ -320,6 +329,7 @@ nlohmann::ordered_json RegistrationSchedule::toJson() const {
     }
     if (s.drrMethod) stageJson["drr"] = nameOf(*s.drrMethod, kStageDrrMethods);
     if (s.drrStep_voxels > 0.0) stageJson["drr_step_voxels"] = s.drrStep_voxels;
+    if (s.drrSlices != CtSliceModel::Samples) stageJson["drr_slices"] = nameOf(s.drrSlices, kCtSliceModels);
     if (s.shiftPrealign) stageJson["shift_prealign"] = true;
     if (s.metalReview) stageJson["metal_review"] = true;
     if (s.hazeSigma_mm > 0.0) stageJson["haze_sigma_mm"] = s.hazeSigma_mm;
@@ -343,8 +353,11 @@ std::vector<std::string> RegistrationSchedule::stageDrrNotes() const {
     if (!s.drrMethod) continue;
     const std::string step =
         s.drrStep_voxels > 0.0 ? fmt::format(" (a sample every {:g} voxel)", s.drrStep_voxels) : std::string();
-    out.push_back(fmt::format("stage '{}' renders its DRRs with the {} method{}", s.name,
-                              nameOf(*s.drrMethod, kStageDrrMethods), step));
+    const std::string slices = s.drrSlices == CtSliceModel::SlabAverages
+                                   ? std::string(", a thick-slice CT's slices read as averages over their thickness")
+                                   : std::string();
+    out.push_back(fmt::format("stage '{}' renders its DRRs with the {} method{}{}", s.name,
+                              nameOf(*s.drrMethod, kStageDrrMethods), step, slices));
   }
   return out;
 }

@@ -75,6 +75,10 @@ struct RegistrationStage {
   /// With drrMethod raycast: the sampling step in voxels (one voxel: the cube root of the voxel volume); 0: the
   /// renderer's default, half the smallest spacing.
   double drrStep_voxels = 0.0;
+  /// With drrMethod raycast: what a CT slice's value stands for (JSON "drr_slices": "samples" or "slab_averages").
+  /// Slab averages render a CT of thick slices deconvolved along them, its slab edges then no longer blurred over two
+  /// slices (DrrVolume::sliceAveragesDeconvolved; a near-cubic grid stays samples; docs/evaluation.md, "Slice profile").
+  CtSliceModel drrSlices = CtSliceModel::Samples;
   /// Before the search, move the start by the translation that lines up each view's DRR with its X-ray in 2D at the
   /// stage's level (ProjectionShiftAligner), when that raises the stage's similarity: a far start's DRR then overlaps
   /// its X-ray before the search looks around it.

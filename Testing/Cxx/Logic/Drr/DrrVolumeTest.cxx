@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -148,4 +149,74 @@ TEST(DrrVolume, ConvertingInPlaceGivesTheSameValuesAsACopy) {
   fct::Volume broken = ct;
   broken.voxels()[7] = NAN;
   EXPECT_NE(fct::DrrVolume::create(std::move(broken)).error().find("NaN"), std::string::npos);
+}
+
+namespace {
+
+/// The value at continuous slice index z of column (i,j) interpolated linearly between slice centres, the outer
+/// slices' values held to the volume's box faces (as TrilinearRayCaster samples along k).
+double linearAlongK(const fct::Volume& v, int i, int j, double z) {
+  const int nk = v.dims().z();
+  const double clamped = std::clamp(z, 0.0, nk - 1.0);
+  const int k0 = std::min(static_cast<int>(std::floor(clamped)), nk - 2);
+  const double t = clamped - k0;
+  return (1.0 - t) * v.at(i, j, k0) + t * v.at(i, j, k0 + 1);
+}
+
+fct::Volume randomThickSliceCt() {
+  fct::Volume ct = fct::Volume::create({5, 4, 9}, {0.45, 0.45, 2.4}, {3, -2, 100}).value();
+  for (std::size_t n = 0; n < ct.voxels().size(); ++n) ct.voxels()[n] = static_cast<float>((n * 7919) % 2400) - 1000.0f;
+  return ct;
+}
+
+}  // namespace
+
+TEST(DrrVolume, SliceAveragesDeconvolvedHaveTheCtsSliceValuesAsTheAveragesOfTheirInterpolant) {
+  const fct::DrrVolume original = fct::DrrVolume::create(randomThickSliceCt()).value();
+  const fct::DrrVolume deconvolved = original.sliceAveragesDeconvolved();
+  ASSERT_EQ(deconvolved.dims(), original.dims());
+  // Averaging the linear interpolant over each slice's box by the midpoint rule, independently of the solver.
+  constexpr int kSamples = 4000;
+  for (int j = 0; j < original.dims().y(); ++j) {
+    for (int i = 0; i < original.dims().x(); ++i) {
+      for (int k = 0; k < original.dims().z(); ++k) {
+        double sum = 0.0;
+        for (int s = 0; s < kSamples; ++s) sum += linearAlongK(deconvolved.values(), i, j, k - 0.5 + (s + 0.5) / kSamples);
+        EXPECT_NEAR(sum / kSamples, original.values().at(i, j, k), 2e-6) << i << " " << j << " " << k;
+      }
+    }
+  }
+  EXPECT_NE(deconvolved.values().voxels(), original.values().voxels()) << "the slab edges are sharpened";
+  EXPECT_NEAR((deconvolved.T_ct_from_ijk().matrix() - original.T_ct_from_ijk().matrix()).norm(), 0.0, 1e-12);
+  EXPECT_EQ(deconvolved.values().spacing_mm(), original.values().spacing_mm());
+  EXPECT_EQ(deconvolved.options().kind, original.options().kind);
+}
+
+TEST(DrrVolume, SliceAveragesDeconvolvedKeepAnAxiallyConstantCtAndAnAllAirColumn) {
+  fct::Volume ct = fct::Volume::create({3, 2, 6}, {0.5, 0.5, 3.0}, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                       -1000.0f)
+                       .value();
+  for (int k = 0; k < 6; ++k) ct.at(1, 1, k) = 400.0f;  // a column of bone, constant along k
+  const fct::DrrVolume original = fct::DrrVolume::create(ct).value();
+  const fct::DrrVolume deconvolved = original.sliceAveragesDeconvolved();
+  for (std::size_t n = 0; n < ct.voxels().size(); ++n) {
+    EXPECT_NEAR(deconvolved.values().voxels()[n], original.values().voxels()[n], 1e-7) << n;
+  }
+  EXPECT_EQ(deconvolved.contentBoxMin_ijk(), original.contentBoxMin_ijk());
+  EXPECT_EQ(deconvolved.contentBoxMax_ijk(), original.contentBoxMax_ijk());
+  fct::Volume oneSlice = fct::Volume::create({2, 2, 1}, {1.0, 1.0, 2.0}).value();
+  oneSlice.voxels() = {0.0f, 100.0f, -500.0f, 1000.0f};
+  const fct::DrrVolume single = fct::DrrVolume::create(oneSlice).value();
+  EXPECT_EQ(single.sliceAveragesDeconvolved().values().voxels(), single.values().voxels()) << "one slice is its average";
+}
+
+TEST(DrrVolume, SlicesAreThickFromOneAndAHalfTimesTheLargerPixel) {
+  const auto withSpacing = [](const Eigen::Vector3d& spacing_mm) {
+    return fct::DrrVolume::create(fct::Volume::create({2, 2, 2}, spacing_mm).value()).value().hasThickSlices();
+  };
+  EXPECT_TRUE(withSpacing({0.45, 0.45, 2.4})) << "the head phantom's 2.4 mm CT";
+  EXPECT_TRUE(withSpacing({0.45, 0.45, 1.0})) << "its original 1 mm slices";
+  EXPECT_FALSE(withSpacing({3.0, 3.0, 3.0})) << "a resampled cubic grid";
+  EXPECT_FALSE(withSpacing({0.8, 0.5, 1.15}));
+  EXPECT_TRUE(withSpacing({0.8, 0.5, 1.25}));
 }

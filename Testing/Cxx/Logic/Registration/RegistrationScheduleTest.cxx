@@ -53,9 +53,12 @@ TEST(RegistrationSchedule, DefaultPresetKeepsThePapersStagesWithASmallerSearch) 
   EXPECT_EQ(s.back().level, 1) << "ends at 1:4: a full-resolution stage pulls toward the CT grid's detail";
   EXPECT_EQ(s.back().drrMethod, fct::DrrMethod::RayCast) << "on trilinear DRRs (a smooth patient)";
   EXPECT_EQ(s.back().drrStep_voxels, 1.0);
+  EXPECT_EQ(s.back().drrSlices, fct::CtSliceModel::SlabAverages) << "a thick slice's edges are not blurred over two";
+  EXPECT_LE(s.back().simplex.tolerance, 0.01) << "a tenth of the 0.1 mm it must hold from the truth";
   for (std::size_t i = 0; i + 1 < s.size(); ++i) EXPECT_FALSE(s[i].drrMethod) << "the others on the case's renderers";
   EXPECT_EQ(preset.value().stageDrrNotes(),
-            std::vector<std::string>{"stage 'vlnc-rois-1:4' renders its DRRs with the raycast method (a sample every 1 voxel)"});
+            std::vector<std::string>{"stage 'vlnc-rois-1:4' renders its DRRs with the raycast method (a sample every 1 "
+                                     "voxel), a thick-slice CT's slices read as averages over their thickness"});
   EXPECT_TRUE(RegistrationSchedule::builtin("paper").value().stageDrrNotes().empty());
   int budget = 0;
   for (const auto& stage : s) budget += stage.maxEvaluations;
@@ -94,6 +97,27 @@ TEST(RegistrationSchedule, VlncDomainIsReadWrittenAndResetByTheNccOnlyAblation) 
   const auto ablated = parsed.value().withAblation(nccOnly);
   EXPECT_EQ(ablated.stages[0].vlncDomain, fct::VlncDomain::LineIntegral);
   EXPECT_TRUE(RegistrationSchedule::fromJson(ablated.toJson(), "ablated").ok()) << "an NCC stage has no domain";
+}
+
+TEST(RegistrationSchedule, SliceModelIsReadAndWrittenOnlyWhereTheSlicesAreSlabAverages) {
+  const auto parsed = RegistrationSchedule::fromJson(
+      nlohmann::json::parse(R"({"name": "x", "stages": [{"name": "s", "metric": "vlnc", "level": 1, "drr": "raycast",
+          "drr_slices": "slab_averages", "pixels": {"set": "rois"}, "search": {"strategy": "local", "max_evaluations": 10}},
+          {"name": "t", "metric": "vlnc", "level": 1, "drr": "raycast", "drr_slices": "samples",
+          "pixels": {"set": "rois"}, "search": {"strategy": "local", "max_evaluations": 10}}]})"),
+      "test.json");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().stages[0].drrSlices, fct::CtSliceModel::SlabAverages);
+  EXPECT_EQ(parsed.value().stages[1].drrSlices, fct::CtSliceModel::Samples);
+  const auto json = parsed.value().toJson();
+  EXPECT_EQ(json["stages"][0]["drr_slices"], "slab_averages");
+  EXPECT_FALSE(json["stages"][1].contains("drr_slices")) << "samples are the default and are not written";
+  const auto again = RegistrationSchedule::fromJson(nlohmann::json::parse(json.dump()), "round trip");
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(again.value().toJson(), json);
+  EXPECT_EQ(parsed.value().stageDrrNotes().front(),
+            "stage 's' renders its DRRs with the raycast method, a thick-slice CT's slices read as averages over their "
+            "thickness");
 }
 
 TEST(RegistrationSchedule, HazeRemovalIsReadAndWrittenOnlyWhereItIsOn) {
@@ -254,6 +278,12 @@ TEST(RegistrationSchedule, RejectsBadSchedulesNamingTheKey) {
       {stageHead + R"("metric": "ncc", "level": 0, "drr": "raycast", "drr_step_voxels": 0, "pixels": {"set": "whole"}, )" +
            search + "]}",
        "drr_step_voxels"},
+      {stageHead + R"("metric": "ncc", "level": 0, "drr_slices": "slab_averages", "pixels": {"set": "whole"}, )" +
+           search + "]}",
+       "drr_slices"},
+      {stageHead + R"("metric": "ncc", "level": 0, "drr": "raycast", "drr_slices": "boxes", "pixels": {"set": "whole"}, )" +
+           search + "]}",
+       "slab_averages"},
       {stageHead + R"("metric": "ncc", "level": 0, "pixels": {"set": "whole"}, "search": {"strategy": "local", )" +
            R"("max_evaluations": 10, "depth_scale": 0.5}}]})",
        "depth_scale"},

@@ -13,6 +13,7 @@
 #include "Registration/RegistrationObjective.h"
 #include "RegistrationTestCase.h"
 #include "Similarity/NccSimilarity.h"
+#include "Simulation/CtSliceDegrader.h"
 #include "Simulation/PhantomBuilder.h"
 #include "TestSupport.h"
 
@@ -380,6 +381,28 @@ TEST(Registration, AStageNamingItsDrrMethodRendersWithItAtItsStep) {
     EXPECT_NE(bad.error().find("step"), std::string::npos) << bad.error();
   }
   EXPECT_FALSE(rc.methodRenderer(fct::DrrMethod::Transgraph).ok());
+  // The phantom's voxels are cubes: its slices are read as samples even where a stage asks for slab averages.
+  EXPECT_EQ(rc.methodRenderer(fct::DrrMethod::RayCast, 1.0, fct::CtSliceModel::SlabAverages).value(), oneVoxel);
+  // Made of 5 mm slices, they are slab averages, rendered deconvolved: another renderer, kept too.
+  auto thickCt = fct::CtSliceDegrader::degrade(p.simulated.ct, 5.0);
+  ASSERT_TRUE(thickCt.ok()) << thickCt.error();
+  auto thickCase = fct::RegistrationCase::create(thickCt.value(), p.simulated.views);
+  ASSERT_TRUE(thickCase.ok()) << thickCase.error();
+  fct::RegistrationCase& thick = thickCase.value();
+  const fct::DrrRenderer* slabs = thick.methodRenderer(fct::DrrMethod::RayCast, 1.0, fct::CtSliceModel::SlabAverages).value();
+  EXPECT_NE(slabs, thick.methodRenderer(fct::DrrMethod::RayCast, 1.0).value());
+  EXPECT_EQ(thick.methodRenderer(fct::DrrMethod::RayCast, 1.0, fct::CtSliceModel::SlabAverages).value(), slabs);
+  const fct::DrrVolume deconvolved = thick.renderer().volume().sliceAveragesDeconvolved();
+  EXPECT_EQ(slabs->volume().values().voxels(), deconvolved.values().voxels());
+  const Eigen::Vector3i block = thick.ctBlockSize(0, 2, T);
+  ASSERT_GT(block.maxCoeff(), 1);
+  EXPECT_EQ(thick.levelRenderer(0, 2, T, 1, fct::DrrMethod::RayCast, 1.0, fct::CtSliceModel::SlabAverages)
+                .value()
+                ->volume()
+                .values()
+                .voxels(),
+            deconvolved.coarsened(block).value().values().voxels())
+      << "a coarse level averages the deconvolved slices";
 
   // The objective of such a stage renders every view with it, and still sees the match at the truth.
   fct::RegistrationStage stage = fastOptions().schedule.stages.back();
