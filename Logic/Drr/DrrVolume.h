@@ -3,8 +3,8 @@
 // (attenuation µ in 1/mm, or the raw voxel value), on the CT's voxel grid, with the CT index <-> CT mm maps.
 
 #include <Eigen/Core>
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <memory>
 #include <mutex>
 #include <string_view>
