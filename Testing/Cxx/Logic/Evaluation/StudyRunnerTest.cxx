@@ -164,7 +164,7 @@ TEST(StudyRunner, NotesSayWhenAScenarioKeepsTheOriginalCt) {
   EXPECT_EQ(notes[1].rfind("every trial registers against X-rays of its own", 0), 0u) << notes[1];
   EXPECT_EQ(notes[2], "DRRs: siddon method");
   EXPECT_EQ(notes[3], "the preset's stage 'vlnc-rois-1:4' renders its DRRs with the raycast method (a sample every 1 "
-                      "voxel), whatever the study's");
+                      "voxel), a thick-slice CT's slices read as averages over their thickness, whatever the study's");
   EXPECT_NE(notes[4].find("scenario 'realistic'"), std::string::npos) << notes[4];
   auto oneSet = study;
   oneSet.setup.xraysPerTrial = false;
