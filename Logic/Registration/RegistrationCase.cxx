@@ -321,7 +321,6 @@ Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int le
                                                            std::optional<DrrMethod> method, double rayCastStep_voxels,
                                                            CtSliceModel slices) {
   if (Status valid = checkViewLevel(v, level); !valid) return fail(valid.error());
-  if (!m_drrVolume->hasThickSlices()) slices = CtSliceModel::Samples;
   const Eigen::Vector3i block = ctBlockSize(v, level, T_world_from_ct, std::max(1, pixelStride));
   const DrrMethod exactMethod = method.value_or(exactRendererOptions(m_drrOptions).method);
   if ((block.array() == 1).all()) return methodRenderer(exactMethod, rayCastStep_voxels, slices);
@@ -331,9 +330,8 @@ Result<const DrrRenderer*> RegistrationCase::levelRenderer(std::size_t v, int le
 
 Result<const DrrRenderer*> RegistrationCase::methodRenderer(DrrMethod method, double rayCastStep_voxels,
                                                             CtSliceModel slices) {
-  if (!m_drrVolume->hasThickSlices()) slices = CtSliceModel::Samples;
   if (method == exactRendererOptions(m_drrOptions).method && rayCastStep_voxels == 0.0 &&
-      slices == CtSliceModel::Samples) {
+      sliceModelFor(slices) == CtSliceModel::Samples) {
     return m_renderer.get();
   }
   if (method == DrrMethod::Transgraph) return fail("the transgraph is built per view, not as a CT renderer");
@@ -345,6 +343,7 @@ Result<const DrrRenderer*> RegistrationCase::keptRenderer(DrrMethod method, cons
   if (!(rayCastStep_voxels >= 0.0 && rayCastStep_voxels <= 10.0)) {  // also NaN
     return fail(fmt::format("ray-cast step must be 0 (the default) to 10 voxels, got {}", rayCastStep_voxels));
   }
+  slices = sliceModelFor(slices);
   const RendererKey key{method, {block.x(), block.y(), block.z()}, rayCastStep_voxels, slices};
   auto found = m_keptRenderers.find(key);
   if (found != m_keptRenderers.end()) return found->second.get();

@@ -248,6 +248,11 @@ class RegistrationCase {
   /// first use and kept.
   Result<const DrrRenderer*> keptRenderer(DrrMethod method, const Eigen::Vector3i& block, double rayCastStep_voxels,
                                           CtSliceModel slices);
+  /// The slice model the case renders for `requested`: slab averages only for a CT of thick slices
+  /// (DrrVolume::hasThickSlices), samples otherwise.
+  CtSliceModel sliceModelFor(CtSliceModel requested) const {
+    return m_drrVolume->hasThickSlices() ? requested : CtSliceModel::Samples;
+  }
 
   std::map<RendererKey, std::shared_ptr<const DrrRenderer>> m_keptRenderers;
   DrrRendererOptions m_drrOptions;
