@@ -160,7 +160,8 @@ if ((REGISTRATION)); then
     awk -v n="$name" -v d="${MEDIAN_TIME[$name/default]}" -v p="${MEDIAN_TIME[$name/paper]}" \
         -v b="${MEDIAN_TIME[$name/baseline]:-nan}" \
         -v ed="${MEDIAN_ERROR[$name/default]}" -v ep="${MEDIAN_ERROR[$name/paper]}" \
-        'BEGIN {printf "ratio paper/default time %s: %.2f\nratio baseline/default time %s: %.2f\n", n, p/d, n, b/d;
+        'BEGIN {printf "ratio paper/default time %s: %.2f\n", n, p/d;
+                if (b != "nan") printf "ratio baseline/default time %s: %.2f\n", n, b/d;
                 printf "error default-paper %s: %+.3f mm (target <= +0.05)\n", n, ed-ep}'
   done
 fi
