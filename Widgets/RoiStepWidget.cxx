@@ -108,6 +108,15 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
   m_spheresCheck = new QCheckBox(tr("Detect more calibration spheres"), exclusionBox);
   m_spheresCheck->setToolTip(tr("The spheres listed in the view file are always excluded; this also finds others"));
   exclusionForm->addRow(m_spheresCheck);
+  m_cutFaceSpin = new QDoubleSpinBox(exclusionBox);
+  m_cutFaceSpin->setRange(-1.0, RegistrationCaseOptions::kMaxCutFaceMargin_mm);
+  m_cutFaceSpin->setDecimals(1);
+  m_cutFaceSpin->setSuffix(tr(" mm"));
+  m_cutFaceSpin->setSpecialValueText(tr("off"));  // shown at the minimum, -1: every ray is compared
+  m_cutFaceSpin->setKeyboardTracking(false);
+  m_cutFaceSpin->setToolTip(tr("Rays that pass within this distance of the CT's end faces (at the start pose) are not "
+                               "compared: beyond them the X-ray shows anatomy the CT lacks. Lowest value: off"));
+  exclusionForm->addRow(tr("Margin around the CT's end faces"), m_cutFaceSpin);
   layout->addWidget(exclusionBox);
 
   m_fractions = new QLabel(this);
@@ -165,6 +174,7 @@ RoiStepWidget::RoiStepWidget(StudioDocument* document, QWidget* parent) : QWidge
   connect(m_marginSpin, &QSpinBox::valueChanged, this, &RoiStepWidget::pushParameters);
   connect(m_fieldOfViewCheck, &QCheckBox::toggled, this, &RoiStepWidget::pushParameters);
   connect(m_spheresCheck, &QCheckBox::toggled, this, &RoiStepWidget::pushParameters);
+  connect(m_cutFaceSpin, &QDoubleSpinBox::valueChanged, this, &RoiStepWidget::pushParameters);
 
   connect(m_document, &StudioDocument::roiParametersChanged, this, [this] {
     syncControls();
@@ -238,7 +248,7 @@ void RoiStepWidget::syncControls() {
   const RoiParameters& p = m_document->roiParameters();
   const QSignalBlocker b1(m_windowSpin), b2(m_thresholdRadio), b3(m_fractionRadio), b4(m_thresholdSlider),
       b5(m_thresholdSpin), b6(m_fractionSlider), b7(m_fractionSpin), b8(m_marginSpin), b9(m_fieldOfViewCheck),
-      b10(m_spheresCheck);
+      b10(m_spheresCheck), b11(m_cutFaceSpin);
   m_windowSpin->setValue(p.windowSize);
   m_thresholdRadio->setChecked(p.useThreshold);
   m_fractionRadio->setChecked(!p.useThreshold);
@@ -249,6 +259,7 @@ void RoiStepWidget::syncControls() {
   m_marginSpin->setValue(p.margin_px);
   m_fieldOfViewCheck->setChecked(p.detectFieldOfView);
   m_spheresCheck->setChecked(p.detectSpheres);
+  m_cutFaceSpin->setValue(p.cutFaceMargin_mm < 0.0 ? m_cutFaceSpin->minimum() : p.cutFaceMargin_mm);
   m_thresholdSlider->setEnabled(p.useThreshold);
   m_thresholdSpin->setEnabled(p.useThreshold);
   m_fractionSlider->setEnabled(!p.useThreshold);
@@ -264,6 +275,9 @@ void RoiStepWidget::pushParameters() {
   p.margin_px = m_marginSpin->value();
   p.detectFieldOfView = m_fieldOfViewCheck->isChecked();
   p.detectSpheres = m_spheresCheck->isChecked();
+  // Below 0 is off; a document's own negative value stays as it is while the spin box shows "off".
+  const double cutFace_mm = m_cutFaceSpin->value();
+  if (cutFace_mm >= 0.0 || p.cutFaceMargin_mm >= 0.0) p.cutFaceMargin_mm = cutFace_mm;
   m_document->setRoiParameters(p);
 }
 

@@ -2,7 +2,8 @@
 // RoiStepWidget: the "ROIs" step, tuning the dynamic regions of interest. Window size and either a normalized-variance
 // threshold or a target fraction (sliders with spin boxes); the kept windows are drawn live as a coloured layer over
 // each X-ray with the kept fraction per view; the excluded pixels (image margin, outside the collimator / field of
-// view, calibration spheres) are drawn in another colour and their settings are editable. The window statistics come
+// view, calibration spheres) are drawn in another colour and their settings are editable, as is the margin around
+// the CT's end faces within which rays are not compared (drawn at registration, not here: it depends on the pose). The window statistics come
 // once per view, level and window size (DynamicRoiSelector on the document's prepared case); moving a slider only
 // re-thresholds them. In threshold mode the document's target fraction follows the mean kept fraction over the views,
 // which is what the registration's ROI stages then keep.
@@ -74,6 +75,8 @@ class RoiStepWidget : public QWidget {
   QDoubleSpinBox* thresholdSpin() const { return m_thresholdSpin; }
   /// The fraction slider.
   QSlider* fractionSlider() const { return m_fractionSlider; }
+  /// The spin box of the margin around the CT's end faces (mm; its minimum reads "off").
+  QDoubleSpinBox* cutFaceSpin() const { return m_cutFaceSpin; }
 
  public slots:
   /// Shows the ROIs chosen on pyramid level `level` (0..2).
@@ -116,6 +119,7 @@ class RoiStepWidget : public QWidget {
   QSpinBox* m_marginSpin;
   QCheckBox* m_fieldOfViewCheck;
   QCheckBox* m_spheresCheck;
+  QDoubleSpinBox* m_cutFaceSpin;  ///< RoiParameters::cutFaceMargin_mm; its lowest value, -1, reads "off"
   QLabel* m_fractions;
   QLabel* m_exclusions;  ///< per view, the share of the image each exclusion takes
   QLabel* m_message;

@@ -238,7 +238,8 @@ void StudioDocument::setRoiParameters(const RoiParameters& parameters) {
   const bool exclusionsChanged = parameters.margin_px != m_roi.margin_px ||
                                  parameters.detectFieldOfView != m_roi.detectFieldOfView ||
                                  parameters.detectSpheres != m_roi.detectSpheres ||
-                                 parameters.sphereMargin_px != m_roi.sphereMargin_px;
+                                 parameters.sphereMargin_px != m_roi.sphereMargin_px ||
+                                 parameters.cutFaceMargin_mm != m_roi.cutFaceMargin_mm;
   m_roi = parameters;
   if (exclusionsChanged) invalidateCase();
   emit roiParametersChanged();
@@ -270,6 +271,7 @@ Result<RegistrationCaseOptions> StudioDocument::caseOptions() const {
   RegistrationCaseOptions options;
   options.drr.method = method.value();
   options.preparation = preparationOptions();
+  options.cutFaceMargin_mm = m_roi.cutFaceMargin_mm;
   return options;
 }
 

@@ -40,6 +40,9 @@ struct RoiParameters {
   bool detectFieldOfView = true;    ///< detect the circular / collimated field of view and exclude outside it
   bool detectSpheres = false;       ///< also detect calibration-sphere shadows (view-file spheres are always used)
   double sphereMargin_px = 2.0;     ///< added to each sphere's radius when excluding it
+  /// Rays passing within this distance of the CT's end faces (mm) are not compared: beyond them the X-ray shows
+  /// anatomy the CT lacks (RegistrationCaseOptions::cutFaceMargin_mm, the CLI's --cut-face-margin-mm); negative: off.
+  double cutFaceMargin_mm = RegistrationCaseOptions::kDefaultCutFaceMargin_mm;
 
   bool operator==(const RoiParameters&) const = default;
 };

@@ -96,7 +96,8 @@ ordered_json sessionJson(const StudioDocument& d, const fs::path& folder) {
                  {"margin_px", roi.margin_px},
                  {"detect_field_of_view", roi.detectFieldOfView},
                  {"detect_spheres", roi.detectSpheres},
-                 {"sphere_margin_px", roi.sphereMargin_px}};
+                 {"sphere_margin_px", roi.sphereMargin_px},
+                 {"cut_face_margin_mm", roi.cutFaceMargin_mm}};
   const StudioRegistrationOptions& options = d.registrationOptions();
   json["registration"] = {{"preset", options.preset}, {"seed", options.seed}, {"drr_method", options.drrMethod}};
   if (!d.results().empty()) {
@@ -273,7 +274,13 @@ Status readRoiSection(const nlohmann::json& section, const SessionFile& file, Se
   r.detectFieldOfView = roi.boolean("detect_field_of_view");
   r.detectSpheres = roi.boolean("detect_spheres");
   r.sphereMargin_px = roi.number("sphere_margin_px");
+  // A session written before the key existed keeps the default.
+  if (roi.has("cut_face_margin_mm")) r.cutFaceMargin_mm = roi.number("cut_face_margin_mm");
   if (roi.ok() && r.targetFraction > 1.0) roi.rejectKey("target_fraction", "must be in (0, 1]");
+  if (roi.ok() && r.cutFaceMargin_mm > RegistrationCaseOptions::kMaxCutFaceMargin_mm) {
+    roi.rejectKey("cut_face_margin_mm", fmt::format("must be at most {} mm (negative: off)",
+                                                    RegistrationCaseOptions::kMaxCutFaceMargin_mm));
+  }
   if (!roi.ok()) return fail(roi.error());
   return Ok{};
 }

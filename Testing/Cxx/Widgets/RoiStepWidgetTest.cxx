@@ -124,6 +124,38 @@ TEST(RoiStepWidget, ExclusionsAreEditableAndAThresholdAboveEveryWindowSaysSo) {
       << "the registration's fraction stays as it was";
 }
 
+TEST(RoiStepWidget, TheCutFaceMarginIsEditableDownToOffAndPreparesTheCaseAgain) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RoiStepWidget step(&session.document);
+  step.attachViews(session.xrayViews, session.sliceViews);
+  step.setActive(true);
+  ASSERT_TRUE(fct::test::waitForCase(session.document)) << step.message().toStdString();
+  QDoubleSpinBox* spin = step.cutFaceSpin();
+  EXPECT_EQ(spin->value(), fct::RegistrationCaseOptions::kDefaultCutFaceMargin_mm) << "the CLI's default";
+  const std::shared_ptr<fct::RegistrationCase> before = session.document.readyCase();
+  ASSERT_NE(before, nullptr);
+
+  spin->setValue(12.5);
+  EXPECT_EQ(session.document.roiParameters().cutFaceMargin_mm, 12.5);
+  EXPECT_EQ(session.document.caseOptions().value().cutFaceMargin_mm, 12.5) << "what the registration's case gets";
+  EXPECT_EQ(session.document.readyCase(), nullptr) << "the case is prepared again with the new margin";
+
+  spin->setValue(spin->minimum());
+  EXPECT_EQ(spin->text(), QStringLiteral("off"));
+  EXPECT_LT(session.document.roiParameters().cutFaceMargin_mm, 0.0) << "negative: every ray is compared";
+
+  fct::RoiParameters parameters = session.document.roiParameters();
+  parameters.cutFaceMargin_mm = -5.0;  // off, as a session file may say it
+  session.document.setRoiParameters(parameters);
+  EXPECT_EQ(spin->text(), QStringLiteral("off"));
+  step.fractionSlider()->setValue(step.fractionSlider()->value() + 5);
+  EXPECT_EQ(session.document.roiParameters().cutFaceMargin_mm, -5.0) << "another control leaves the value as it is";
+  parameters = session.document.roiParameters();
+  parameters.cutFaceMargin_mm = 3.0;
+  session.document.setRoiParameters(parameters);
+  EXPECT_EQ(spin->value(), 3.0) << "the spin box follows the document";
+}
+
 TEST(RoiStepWidget, SwitchingToTheThresholdStartsWhereTheFractionWas) {
   fct::test::StepTestSession session(fct::test::smallPhantom());
   fct::RoiStepWidget step(&session.document);

@@ -37,6 +37,7 @@ void fillDocument(StudioDocument& d) {
   roi.varianceThreshold = 1.7;
   roi.margin_px = 5;
   roi.detectFieldOfView = false;
+  roi.cutFaceMargin_mm = 12.5;
   d.setRoiParameters(roi);
   d.setRegistrationOptions({"paper", 42, "raycast"});
   fct::RegistrationResult result;
@@ -179,6 +180,10 @@ TEST(StudioSession, BadValueMessagesNameTheSectionAndEntry) {
       {R"("roi": {"window_size": 7, "use_threshold": false, "target_fraction": 1.5, "variance_threshold": 0,
                   "margin_px": 0, "detect_field_of_view": true, "detect_spheres": true, "sphere_margin_px": 2})",
        "target_fraction"},
+      {R"("roi": {"window_size": 7, "use_threshold": false, "target_fraction": 0.5, "variance_threshold": 0,
+                  "margin_px": 0, "detect_field_of_view": true, "detect_spheres": true, "sphere_margin_px": 2,
+                  "cut_face_margin_mm": 501})",
+       "roi: key 'cut_face_margin_mm' must be at most 500 mm"},
       {R"("registration": {"preset": "fast", "seed": -1, "drr_method": "siddon"})", "registration"},
       {R"("result": {"verdict": "maybe"})", "use accepted, rejected or undecided"},
       {R"("results": {"verdict": "accepted"})", "results must be an array"},
