@@ -3,8 +3,8 @@
 // threshold or a target fraction (sliders with spin boxes); the kept windows are drawn live as a coloured layer over
 // each X-ray with the kept fraction per view; the excluded pixels (image margin, outside the collimator / field of
 // view, calibration spheres) are drawn in another colour and their settings are editable, as is the margin around
-// the CT's end faces within which rays are not compared (drawn at registration, not here: it depends on the pose). The window statistics come
-// once per view, level and window size (DynamicRoiSelector on the document's prepared case); moving a slider only
+// the CT's end faces within which rays are not compared (not drawn: it depends on the pose). The window statistics
+// come once per view, level and window size (DynamicRoiSelector on the document's prepared case); moving a slider only
 // re-thresholds them. In threshold mode the document's target fraction follows the mean kept fraction over the views,
 // which is what the registration's ROI stages then keep.
 
