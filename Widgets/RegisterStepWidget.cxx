@@ -56,6 +56,16 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   m_methodCombo->setToolTip(tr("transgraph: precomputed ray tables, one per view, built around the initial pose at the "
                                "first run (takes a while once; later runs of the same case reuse them)"));
   form->addRow(tr("DRR method"), m_methodCombo);
+  m_boneContrastSpin = new QDoubleSpinBox(optionsBox);
+  m_boneContrastSpin->setRange(0.1, DrrValueOptions::kMaxBoneContrast);
+  m_boneContrastSpin->setDecimals(2);
+  m_boneContrastSpin->setSingleStep(0.1);
+  m_boneContrastSpin->setKeyboardTracking(false);
+  m_boneContrastSpin->setToolTip(tr("How much more the X-ray's beam sees of bone than the CT's did: the DRRs' "
+                                    "attenuation above 100 HU is scaled by it. %1 suits an 80 kVp fluoroscope and a "
+                                    "120 kVp CT, about 1.3 a 100 kVp one; 1: the CT's own contrast")
+                                     .arg(RegistrationCaseOptions::kDefaultBoneContrast));
+  form->addRow(tr("Bone contrast"), m_boneContrastSpin);
   layout->addWidget(optionsBox);
 
   auto* ablationBox = new QGroupBox(tr("Switch off (ablation)"), this);
@@ -105,6 +115,7 @@ RegisterStepWidget::RegisterStepWidget(StudioDocument* document, QWidget* parent
   connect(m_presetCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_seedSpin, &QSpinBox::valueChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_methodCombo, &QComboBox::currentIndexChanged, this, &RegisterStepWidget::pushOptions);
+  connect(m_boneContrastSpin, &QDoubleSpinBox::valueChanged, this, &RegisterStepWidget::pushOptions);
   connect(m_document, &StudioDocument::registrationOptionsChanged, this, &RegisterStepWidget::syncControls);
   connect(m_document, &StudioDocument::resultChanged, this, &RegisterStepWidget::showDocumentResult);
   for (auto signal : {&StudioDocument::ctChanged, &StudioDocument::viewsChanged, &StudioDocument::initialPoseChanged}) {
@@ -333,7 +344,7 @@ void RegisterStepWidget::appendLog(const QString& line) { m_log->appendPlainText
 
 void RegisterStepWidget::syncControls() {
   const StudioRegistrationOptions& options = m_document->registrationOptions();
-  const QSignalBlocker b1(m_presetCombo), b2(m_seedSpin), b3(m_methodCombo);
+  const QSignalBlocker b1(m_presetCombo), b2(m_seedSpin), b3(m_methodCombo), b4(m_boneContrastSpin);
   const QString preset = QString::fromStdString(options.preset);
   if (m_presetCombo->findText(preset) < 0) m_presetCombo->addItem(preset);
   m_presetCombo->setCurrentText(preset);
@@ -341,6 +352,7 @@ void RegisterStepWidget::syncControls() {
   const QString method = QString::fromStdString(options.drrMethod);
   if (m_methodCombo->findText(method) < 0) m_methodCombo->addItem(method);
   m_methodCombo->setCurrentText(method);
+  m_boneContrastSpin->setValue(options.boneContrast);
 }
 
 void RegisterStepWidget::pushOptions() {
@@ -348,6 +360,7 @@ void RegisterStepWidget::pushOptions() {
   options.preset = m_presetCombo->currentText().toStdString();
   options.seed = static_cast<std::uint32_t>(m_seedSpin->value());
   options.drrMethod = m_methodCombo->currentText().toStdString();
+  options.boneContrast = m_boneContrastSpin->value();
   m_document->setRegistrationOptions(options);
 }
 
@@ -519,9 +532,10 @@ void RegisterStepWidget::endThread() { endWorkerThread(m_thread, m_worker); }
 void RegisterStepWidget::setRunningUi(bool running) {
   m_cancelButton->setEnabled(running);
   if (!running) m_cancelRequested = false;
-  for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_noRoisCheck,
-                                                          m_noPyramidCheck, m_nccOnlyCheck, m_localOnlyCheck,
-                                                          m_cmaesCheck, m_noTransgraphCheck, m_noCtPyramidCheck}) {
+  for (QWidget* control : std::initializer_list<QWidget*>{m_presetCombo, m_seedSpin, m_methodCombo, m_boneContrastSpin,
+                                                          m_noRoisCheck, m_noPyramidCheck, m_nccOnlyCheck,
+                                                          m_localOnlyCheck, m_cmaesCheck, m_noTransgraphCheck,
+                                                          m_noCtPyramidCheck}) {
     control->setEnabled(!running);
   }
   updateRunButton();

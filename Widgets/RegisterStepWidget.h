@@ -22,6 +22,7 @@ class QCheckBox;
 class QComboBox;
 class QLabel;
 class QPlainTextEdit;
+class QDoubleSpinBox;
 class QProgressBar;
 class QPushButton;
 class QSpinBox;
@@ -62,6 +63,8 @@ class RegisterStepWidget : public QWidget {
   QString logText() const;
   /// What Run still needs, in words ("a CT (Data step), an initial pose (Initial pose step)"); empty when ready.
   QString missingInputs() const;
+  /// The bone contrast control (RegistrationCaseOptions::boneContrast of the case).
+  QDoubleSpinBox* boneContrastSpin() const { return m_boneContrastSpin; }
   /// The Run button (disabled while inputs are missing, its tooltip naming them).
   QPushButton* runButton() const { return m_runButton; }
   /// The progress line under the bar, as shown.
@@ -145,6 +148,7 @@ class RegisterStepWidget : public QWidget {
   QLabel* m_estimateLabel;
   QSpinBox* m_seedSpin;
   QComboBox* m_methodCombo;
+  QDoubleSpinBox* m_boneContrastSpin;
   QCheckBox* m_noRoisCheck;
   QCheckBox* m_noPyramidCheck;
   QCheckBox* m_nccOnlyCheck;

@@ -248,7 +248,7 @@ void StudioDocument::setRoiParameters(const RoiParameters& parameters) {
 
 void StudioDocument::setRegistrationOptions(const StudioRegistrationOptions& options) {
   if (options == m_options) return;
-  if (options.drrMethod != m_options.drrMethod) invalidateCase();
+  if (options.drrMethod != m_options.drrMethod || options.boneContrast != m_options.boneContrast) invalidateCase();
   m_options = options;
   emit registrationOptionsChanged();
   touch();
@@ -272,6 +272,7 @@ Result<RegistrationCaseOptions> StudioDocument::caseOptions() const {
   options.drr.method = method.value();
   options.preparation = preparationOptions();
   options.cutFaceMargin_mm = m_roi.cutFaceMargin_mm;
+  options.boneContrast = m_options.boneContrast;
   return options;
 }
 

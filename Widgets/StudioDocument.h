@@ -52,6 +52,7 @@ struct StudioRegistrationOptions {
   std::string preset = RegistrationSchedule::kDefaultPreset;  ///< built-in preset name or a preset JSON file
   std::uint32_t seed = 1;            ///< seed of the random searches
   std::string drrMethod = "siddon";  ///< DRR method (DrrRendererFactory names)
+  double boneContrast = RegistrationCaseOptions::kDefaultBoneContrast;  ///< the DRRs' bone contrast (case option)
 
   bool operator==(const StudioRegistrationOptions&) const = default;
 };

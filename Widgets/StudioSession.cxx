@@ -99,7 +99,10 @@ ordered_json sessionJson(const StudioDocument& d, const fs::path& folder) {
                  {"sphere_margin_px", roi.sphereMargin_px},
                  {"cut_face_margin_mm", roi.cutFaceMargin_mm}};
   const StudioRegistrationOptions& options = d.registrationOptions();
-  json["registration"] = {{"preset", options.preset}, {"seed", options.seed}, {"drr_method", options.drrMethod}};
+  json["registration"] = {{"preset", options.preset},
+                          {"seed", options.seed},
+                          {"drr_method", options.drrMethod},
+                          {"bone_contrast", options.boneContrast}};
   if (!d.results().empty()) {
     ordered_json results = ordered_json::array();
     for (const StudioResult& entry : d.results()) results.push_back(resultJson(entry.result, entry.verdict));
@@ -285,12 +288,19 @@ Status readRoiSection(const nlohmann::json& section, const SessionFile& file, Se
   return Ok{};
 }
 
-/// "registration": the preset, seed and DRR method. Fails naming the key with a bad value.
+/// "registration": the preset, seed, DRR method and bone contrast. Fails naming the key with a bad value.
 Status readRegistrationSection(const nlohmann::json& section, const SessionFile& file, SessionContent& content) {
   JsonReader registration(section, file.where + ": registration");
-  content.options.preset = registration.string("preset");
-  content.options.seed = static_cast<std::uint32_t>(registration.integer("seed", 0));
-  content.options.drrMethod = registration.string("drr_method");
+  StudioRegistrationOptions& r = content.options;
+  r.preset = registration.string("preset");
+  r.seed = static_cast<std::uint32_t>(registration.integer("seed", 0));
+  r.drrMethod = registration.string("drr_method");
+  // A session written before the key existed keeps the default.
+  if (registration.has("bone_contrast")) r.boneContrast = registration.number("bone_contrast");
+  if (registration.ok() && !(r.boneContrast > 0.0 && r.boneContrast <= DrrValueOptions::kMaxBoneContrast)) {
+    registration.rejectKey("bone_contrast",
+                           fmt::format("must be above 0 and at most {:g}", DrrValueOptions::kMaxBoneContrast));
+  }
   if (!registration.ok()) return fail(registration.error());
   return Ok{};
 }

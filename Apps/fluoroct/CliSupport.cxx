@@ -76,6 +76,19 @@ void addCutFaceMarginOption(CLI::App& command, double& margin_mm) {
       ->capture_default_str();
 }
 
+void addBoneContrastOption(CLI::App& command, double& contrast) {
+  command
+      .add_option("--bone-contrast", contrast,
+                  "Scale the attenuation the DRRs give CT values above 100 HU (bone) by this factor: how much more "
+                  "the X-ray's beam sees of bone than the CT's did. The default suits an 80 kVp fluoroscope and a "
+                  "120 kVp CT, about 1.3 a 100 kVp one; 1 = the CT's own contrast (docs/registration.md, \"Bone "
+                  "contrast\")")
+      ->check(finiteNumber([](double value) { return value > 0.0 && value <= DrrValueOptions::kMaxBoneContrast; },
+                           fmt::format("a number above 0 and up to {:g}", DrrValueOptions::kMaxBoneContrast),
+                           "FACTOR"))
+      ->capture_default_str();
+}
+
 InterruptGuard::InterruptGuard() {
   g_interrupted = false;
   m_previous = std::signal(SIGINT, onInterrupt);

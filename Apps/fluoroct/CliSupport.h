@@ -41,6 +41,10 @@ CLI::Validator positiveNumber();
 /// RegistrationCaseOptions::kMaxCutFaceMargin_mm, negative for off, shown with its default.
 void addCutFaceMarginOption(CLI::App& command, double& margin_mm);
 
+/// Adds --bone-contrast (register, track) bound to `contrast`: a finite number above 0 and up to
+/// DrrValueOptions::kMaxBoneContrast, shown with its default.
+void addBoneContrastOption(CLI::App& command, double& contrast);
+
 /// While alive, Ctrl-C (SIGINT) sets cancelFlag() instead of ending the process, so a long Logic operation can stop
 /// cleanly; the previous handler is restored when the guard goes, on every path out of its scope. Create one at a time.
 class InterruptGuard {

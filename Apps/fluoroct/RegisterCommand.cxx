@@ -54,6 +54,7 @@ struct Options {
   bool noMetalMask = false;
   double metalMinExcess = MetalMaskOptions{}.minExcess;
   double cutFaceMargin_mm = RegistrationCaseOptions{}.cutFaceMargin_mm;
+  double boneContrast = RegistrationCaseOptions{}.boneContrast;
   double rayCastStep_mm = DrrRendererOptions{}.rayCastStep_mm;
   bool rayCastStepGiven = false;  ///< --raycast-step-mm was on the command line (it only applies to --method raycast)
   std::string masks;  ///< optional folder for each view's full-resolution validity mask (PNG)
@@ -158,6 +159,7 @@ RegistrationCaseOptions caseOptionsFor(const Options& o, const Inputs& in) {
   options.preparation.excludeMetal = !o.noMetalMask;
   options.preparation.metal.minExcess = o.metalMinExcess;
   options.cutFaceMargin_mm = o.cutFaceMargin_mm;
+  options.boneContrast = o.boneContrast;
   return options;
 }
 
@@ -303,6 +305,7 @@ nlohmann::ordered_json resultJson(const Options& o, const RegistrationResult& r,
                                  {"metal_mask", !o.noMetalMask},
                                  {"metal_min_excess", o.metalMinExcess},
                                  {"cut_face_margin_mm", o.cutFaceMargin_mm},
+                                 {"bone_contrast", o.boneContrast},
                                  {"raycast_step_mm", o.rayCastStep_mm}};
   for (const auto& item : json["options"].items()) options[item.key()] = item.value();
   json["options"] = std::move(options);
@@ -527,6 +530,7 @@ void registerRegisterCommand(CLI::App& app, CommandAction& action) {
                       "fraction of signal it passes; physical, log-linear detector images)")
       ->capture_default_str();
   addCutFaceMarginOption(*command, options->cutFaceMargin_mm);
+  addBoneContrastOption(*command, options->boneContrast);
   command->add_option("--masks", options->masks,
                       "Folder for one PNG per view (<view>_mask.png): white pixels are compared with the DRR, black "
                       "ones excluded (field border, margin, calibration spheres, metal; rewritten after a metal review)");

@@ -46,6 +46,7 @@ struct Options {
   bool noFieldOfView = false;
   bool noMetalMask = false;
   double cutFaceMargin_mm = RegistrationCaseOptions::kDefaultCutFaceMargin_mm;
+  double boneContrast = RegistrationCaseOptions::kDefaultBoneContrast;
   std::string igtl;
   std::string igtlDevice = "FluoroCT";
 };
@@ -110,6 +111,7 @@ RegistrationCaseOptions caseOptionsFor(const Options& o, DrrMethod method, const
   options.preparation.detectFieldOfView = !o.noFieldOfView;
   options.preparation.excludeMetal = !o.noMetalMask;
   options.cutFaceMargin_mm = o.cutFaceMargin_mm;
+  options.boneContrast = o.boneContrast;
   return options;
 }
 
@@ -161,6 +163,7 @@ nlohmann::ordered_json trackJson(const Options& o, const TrackRun& run) {
                                   {"views", o.views},
                                   {"preset", o.preset},
                                   {"cut_face_margin_mm", o.cutFaceMargin_mm},
+                                  {"bone_contrast", o.boneContrast},
                                   {"level", run.tracker.level},
                                   {"roi_fraction", run.tracker.roiFraction},
                                   {"max_evaluations", run.tracker.maxEvaluations},
@@ -389,6 +392,7 @@ void registerTrackCommand(CLI::App& app, CommandAction& action) {
   command->add_flag("--no-fov", options->noFieldOfView, "Skip the field-of-view (collimator) detection");
   command->add_flag("--no-metal-mask", options->noMetalMask, "Compare metal shadows too instead of excluding them");
   addCutFaceMarginOption(*command, options->cutFaceMargin_mm);
+  addBoneContrastOption(*command, options->boneContrast);
   auto* igtl = command->add_option("--igtl", options->igtl,
                                    "Send each frame's pose to an OpenIGTLink server HOST:PORT as a TRANSFORM (RAS)");
   command->add_option("--igtl-device", options->igtlDevice, "Device name of the TRANSFORM (1-20 characters)")

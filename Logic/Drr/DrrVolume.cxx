@@ -21,6 +21,11 @@ Result<DrrVolume> DrrVolume::prepare(const Volume& ct, const DrrValueOptions& op
       (!std::isfinite(options.waterAttenuation_per_mm) || options.waterAttenuation_per_mm <= 0.0)) {
     return fail(fmt::format("water attenuation must be positive and finite, got {} /mm", options.waterAttenuation_per_mm));
   }
+  if (options.kind == DrrValueKind::Attenuation &&
+      !(options.boneContrast > 0.0 && options.boneContrast <= DrrValueOptions::kMaxBoneContrast)) {  // also NaN
+    return fail(fmt::format("bone contrast must be above 0 and at most {:g}, got {}", DrrValueOptions::kMaxBoneContrast,
+                            options.boneContrast));
+  }
   DrrVolume volume;
   volume.m_options = options;
   volume.m_T_ct_from_ijk = ct.T_lps_from_ijk();
@@ -53,6 +58,8 @@ Result<DrrVolume> DrrVolume::create(Volume&& ct, const DrrValueOptions& options)
 Status DrrVolume::convertFrom(const std::vector<float>& hu) {
   std::vector<float>& voxels = m_values.voxels();
   const float mu_water = static_cast<float>(m_options.waterAttenuation_per_mm);
+  const float boneFrom = static_cast<float>(DrrValueOptions::kBoneFrom_hu);
+  const float boneSlope = static_cast<float>(m_options.boneContrast) * 0.001f;  // per HU above boneFrom
   const bool attenuation = m_options.kind == DrrValueKind::Attenuation;
   // Each voxel is read before it is written, so `hu` may be `voxels` itself.
   const std::size_t nonFinite = tbb::parallel_reduce(
@@ -64,7 +71,8 @@ Status DrrVolume::convertFrom(const std::vector<float>& hu) {
             ++count;
             voxels[n] = 0.0f;
           } else if (attenuation) {
-            voxels[n] = value <= -1000.0f ? 0.0f : mu_water * (1.0f + value * 0.001f);
+            const float bone = std::max(value - boneFrom, 0.0f);
+            voxels[n] = value <= -1000.0f ? 0.0f : mu_water * (1.0f + (value - bone) * 0.001f + bone * boneSlope);
           } else {
             voxels[n] = value;
           }

@@ -17,7 +17,9 @@ namespace fct {
 
 /// What a DRR integrates along each ray.
 enum class DrrValueKind {
-  /// µ = µ_water · (1 + HU / 1000) in 1/mm, HU <= -1000 (air and below) clamped to 0; the DRR ∫µ dl is dimensionless.
+  /// µ = µ_water · (1 + HU / 1000) in 1/mm up to DrrValueOptions::kBoneFrom_hu, with the part above it times k (the
+  /// bone contrast, DrrValueOptions::boneContrast); HU <= -1000 (air and below) clamped to 0; the DRR ∫µ dl is
+  /// dimensionless.
   Attenuation,
   /// The voxel value as stored (HU for a CT, negative in air); the DRR ∫value dl is in value·mm.
   Raw,
@@ -29,8 +31,18 @@ struct DrrValueOptions {
   /// µ/ρ = 0.2059 cm²/g (NIST XCOM / Hubbell & Seltzer, NIST Standard Reference Database 126, liquid water), ρ = 1 g/cm³.
   static constexpr double kWaterAttenuationAt60keV_per_mm = 0.02059;
 
+  /// The largest bone contrast accepted: beyond it the CT's bone would outweigh everything else in a DRR.
+  static constexpr double kMaxBoneContrast = 10.0;
+  /// CT values above this are water-bone mixtures; soft tissues (about -100 to +100 HU) and fat are water-like.
+  static constexpr double kBoneFrom_hu = 100.0;
+
   DrrValueKind kind = DrrValueKind::Attenuation;
   double waterAttenuation_per_mm = kWaterAttenuationAt60keV_per_mm;  ///< µ_water used by Attenuation
+  /// The attenuation a CT value adds above kBoneFrom_hu (water-bone mixtures) is scaled by this factor, in
+  /// (0, kMaxBoneContrast]. A CT measures attenuation at its own beam's energy; at a softer beam's, bone's excess over
+  /// water is larger (calcium's photoelectric absorption), while water-like tissue scales with water: the bilinear HU
+  /// scaling of CT-based attenuation correction. 1: the CT's own contrast.
+  double boneContrast = 1.0;
 };
 
 /// What a CT slice's value stands for along the slice axis (k), for a renderer that interpolates between slices.
@@ -50,8 +62,8 @@ class DrrVolume {
  public:
   DrrVolume() = default;
 
-  /// Converts a CT once into a new grid. Fails on an empty volume, non-finite voxels, or a non-positive or non-finite
-  /// µ_water.
+  /// Converts a CT once into a new grid. Fails on an empty volume, non-finite voxels, a non-positive or non-finite
+  /// µ_water, or a bone contrast outside (0, kMaxBoneContrast].
   static Result<DrrVolume> create(const Volume& ct, const DrrValueOptions& options = {});
   /// As above, converting the CT's own voxels in place (no second copy of a large CT); `ct` is consumed.
   static Result<DrrVolume> create(Volume&& ct, const DrrValueOptions& options = {});

@@ -36,7 +36,9 @@ Result<RegistrationCase> RegistrationCase::create(const Volume& ct, const std::v
   const auto cancelled = [&] { return monitor.cancelled(); };
   monitor.report("CT", 0.0, "preparing the CT for DRRs");
 
-  auto drrVolume = DrrVolume::create(ct);
+  DrrValueOptions values;
+  values.boneContrast = options.boneContrast;
+  auto drrVolume = DrrVolume::create(ct, values);
   if (!drrVolume) return fail("CT: " + drrVolume.error());
   result.m_drrVolume = std::make_shared<const DrrVolume>(std::move(drrVolume).value());
   result.m_drrOptions = options.drr;

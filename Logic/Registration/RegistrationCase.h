@@ -54,6 +54,13 @@ struct RegistrationCaseOptions {
   /// that the CT lacks. Negative: off. The mask is made at the initial pose (and again at a stage's start when the
   /// bone moved more than 5 mm from it), so it is as right as that pose; a face with no tissue cuts nothing.
   double cutFaceMargin_mm = kDefaultCutFaceMargin_mm;
+  /// The bone contrast of a case unless told otherwise: an 80 kVp fluoroscope against a 120 kVp CT. For ICRU cortical
+  /// bone (NIST XCOM), µ_bone / µ_water - 1.1 is 2.5 at 50 keV, about the mean energy of an 80 kVp beam behind a
+  /// patient, against 1.5 at 70 keV, a 120 kVp CT's (docs/registration.md, "Bone contrast").
+  static constexpr double kDefaultBoneContrast = 1.6;
+  /// The attenuation the DRRs give CT values above 100 HU is scaled by this factor (DrrValueOptions::boneContrast), in
+  /// (0, 10]: how much more the X-ray's beam sees of bone than the CT's did. 1: the CT's own contrast.
+  double boneContrast = kDefaultBoneContrast;
   /// Transgraph method: the pose (CT mm -> world mm, LPS) around which each view's table is built, e.g. the initial
   /// pose from landmarks. nullopt: the tables are built at the initial pose of the first Registration::run.
   std::optional<Eigen::Isometry3d> T_expected_world_from_ct;
@@ -90,6 +97,8 @@ class RegistrationCase {
                                          const RegistrationCaseOptions& options = {},
                                          const ProgressMonitor& monitor = {});
 
+  /// The CT as the DRRs see it: attenuation values with the case's bone contrast, on the CT's grid.
+  const DrrVolume& drrVolume() const { return *m_drrVolume; }
   /// The exact DRR renderer shared by all views: the method's renderer, Siddon for the transgraph method.
   const DrrRenderer& renderer() const { return *m_renderer; }
   /// The exact renderer for view v at pyramid `level` with the CT near pose T_world_from_ct: renderer()'s method over

@@ -12,6 +12,7 @@
 #include "IO/Project/LandmarkFile.h"
 #include "IO/Project/PoseFile.h"
 #include "IO/Project/ViewFile.h"
+#include "Registration/RegistrationCase.h"
 #include "Registration/RegistrationResultJson.h"
 #include "SimulatedCliCase.h"
 #include "TestSupport.h"
@@ -74,6 +75,7 @@ TEST(RegisterCommand, RegistersASimulatedCaseFromAPoseFileAndWritesTheResult) {
   }
   // The default cut-face margin (5 mm): each view's metal share of the field whose rays clear the CT's cut faces.
   EXPECT_EQ(json["options"]["cut_face_margin_mm"].get<double>(), 5.0);
+  EXPECT_EQ(json["options"]["bone_contrast"].get<double>(), fct::RegistrationCaseOptions::kDefaultBoneContrast);
   EXPECT_NE(run.out.find("of the field whose rays clear the CT's cut faces) at the final pose"), std::string::npos)
       << run.out;
   for (const char* view : {"ap", "lateral", "oblique45"}) {
@@ -259,6 +261,13 @@ TEST(RegisterCommand, FailsWithOneErrorLineOnBadInput) {
     EXPECT_TRUE(oneErrorLine(badMargin)) << badMargin.err;
     EXPECT_NE(badMargin.err.find("--cut-face-margin-mm"), std::string::npos) << badMargin.err;
     EXPECT_NE(badMargin.err.find("up to 500"), std::string::npos) << badMargin.err;
+  }
+  // A bone contrast of 0, beyond the largest, or not a number: refused by the flag.
+  for (const std::string contrast : {"0", "11", "nan"}) {
+    const auto badContrast = fct::test::runCli(base + init + " --bone-contrast " + contrast);
+    EXPECT_TRUE(oneErrorLine(badContrast)) << badContrast.err;
+    EXPECT_NE(badContrast.err.find("--bone-contrast"), std::string::npos) << badContrast.err;
+    EXPECT_NE(badContrast.err.find("above 0 and up to 10"), std::string::npos) << badContrast.err;
   }
 
   Eigen::Isometry3d far = truth;

@@ -27,7 +27,7 @@ TEST(TrackCommand, TracksATinyBiplaneSequenceAndWritesJsonCsvAndPlot) {
   ASSERT_TRUE(fct::PoseFile::write(fct::test::perturbed(truth[0]), dir / "init.json").ok());
   const auto run =
       fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) +
-                        " --level 0 --cut-face-margin-mm 2");
+                        " --level 0 --cut-face-margin-mm 2 --bone-contrast 1.5");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("tracked 4 of 4 frames"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("frame    3/4"), std::string::npos) << run.err;
@@ -40,6 +40,7 @@ TEST(TrackCommand, TracksATinyBiplaneSequenceAndWritesJsonCsvAndPlot) {
   EXPECT_EQ(json.value().at("options").at("frame_drr"), "siddon") << "the automatic choice for two views";
   EXPECT_EQ(json.value().at("options").at("depth_scale"), 10.0);
   EXPECT_EQ(json.value().at("options").at("cut_face_margin_mm"), 2.0);
+  EXPECT_EQ(json.value().at("options").at("bone_contrast"), 1.5);
   EXPECT_GT(json.value().at("frames_per_second").get<double>(), 0.0);
   for (std::size_t f = 0; f < frames.size(); ++f) {
     EXPECT_EQ(frames[f].at("index"), static_cast<int>(f));
@@ -90,7 +91,8 @@ TEST(TrackCommand, BadInputsGiveOneClearErrorLine) {
       {" --frame-drr transgraph", "--frame-drr"},
       {" --frame-drr box", "--frame-drr"},
       {" --confirm-mm 0", "confirmation tolerances"},
-      {" --cut-face-margin-mm 600", "--cut-face-margin-mm"}};
+      {" --cut-face-margin-mm 600", "--cut-face-margin-mm"},
+      {" --bone-contrast 0", "--bone-contrast"}};
   for (const auto& [option, expected] : badOptions) {
     run = fct::test::runCli(trackArgs(dir, (dir / "track_views.json").string(), (dir / "out").string()) + option);
     EXPECT_TRUE(fct::test::oneErrorLine(run)) << option << ": " << run.err;

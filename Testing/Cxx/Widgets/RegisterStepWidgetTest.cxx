@@ -3,10 +3,12 @@
 // missing initial pose is refused with a message.
 #include <gtest/gtest.h>
 
+#include <QDoubleSpinBox>
 #include <QPushButton>
 #include <QSignalSpy>
 
 #include "Evaluation/PoseOffset.h"
+#include "Registration/RegistrationCase.h"
 #include "Registration/RegistrationSchedule.h"
 #include "StepTestSession.h"
 #include "Widgets/RegisterStepWidget.h"
@@ -131,6 +133,29 @@ TEST(RegisterStepWidget, EveryAblationSwitchIncludingTheTransgraphRoundTrips) {
   onlyTransgraphOff.noTransgraph = true;
   step.setAblation(onlyTransgraphOff);
   EXPECT_EQ(step.ablation().activeNames(), std::vector<std::string>{"no-transgraph"});
+}
+
+TEST(RegisterStepWidget, TheBoneContrastIsEditableAndPreparesTheCaseAgain) {
+  fct::test::StepTestSession session(fct::test::smallPhantom());
+  fct::RegisterStepWidget step(&session.document);
+  QDoubleSpinBox* spin = step.boneContrastSpin();
+  EXPECT_EQ(spin->value(), fct::RegistrationCaseOptions::kDefaultBoneContrast) << "the CLI's default";
+  EXPECT_EQ(session.document.caseOptions().value().boneContrast, fct::RegistrationCaseOptions::kDefaultBoneContrast);
+  ASSERT_TRUE(session.document.preparedCase().ok());
+  ASSERT_NE(session.document.readyCase(), nullptr);
+
+  spin->setValue(1.25);
+  EXPECT_EQ(session.document.registrationOptions().boneContrast, 1.25);
+  EXPECT_EQ(session.document.caseOptions().value().boneContrast, 1.25) << "what the registration's case gets";
+  EXPECT_EQ(session.document.readyCase(), nullptr) << "the case is prepared again with the new contrast";
+  auto prepared = session.document.preparedCase();
+  ASSERT_TRUE(prepared.ok()) << prepared.error();
+  EXPECT_EQ(prepared.value()->drrVolume().options().boneContrast, 1.25);
+
+  fct::StudioRegistrationOptions options = session.document.registrationOptions();
+  options.boneContrast = 1.0;  // as a session file may say it
+  session.document.setRegistrationOptions(options);
+  EXPECT_EQ(spin->value(), 1.0) << "the spin box follows the document";
 }
 
 TEST(RegisterStepWidget, StagesHavePlainNamesAndMessagesReachTheStatusLine) {

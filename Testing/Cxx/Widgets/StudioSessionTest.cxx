@@ -39,7 +39,7 @@ void fillDocument(StudioDocument& d) {
   roi.detectFieldOfView = false;
   roi.cutFaceMargin_mm = 12.5;
   d.setRoiParameters(roi);
-  d.setRegistrationOptions({"paper", 42, "raycast"});
+  d.setRegistrationOptions({"paper", 42, "raycast", 1.25});
   fct::RegistrationResult result;
   result.T_initial = initial;
   result.T_world_from_ct = initial * Eigen::Translation3d(1, 1, 1);
@@ -185,6 +185,8 @@ TEST(StudioSession, BadValueMessagesNameTheSectionAndEntry) {
                   "cut_face_margin_mm": 501})",
        "roi: key 'cut_face_margin_mm' must be at most 500 mm"},
       {R"("registration": {"preset": "fast", "seed": -1, "drr_method": "siddon"})", "registration"},
+      {R"("registration": {"preset": "fast", "seed": 1, "drr_method": "siddon", "bone_contrast": 0})",
+       "registration: key 'bone_contrast' must be above 0 and at most 10"},
       {R"("result": {"verdict": "maybe"})", "use accepted, rejected or undecided"},
       {R"("results": {"verdict": "accepted"})", "results must be an array"},
       {R"("results": [{"verdict": "maybe"}])", "results[0]"},

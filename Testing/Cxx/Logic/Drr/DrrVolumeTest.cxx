@@ -28,6 +28,22 @@ TEST(DrrVolume, ConvertsHuToAttenuationWithAirClampedToZero) {
   EXPECT_EQ(volume.value().options().kind, fct::DrrValueKind::Attenuation);
 }
 
+TEST(DrrVolume, BoneContrastScalesOnlyTheAttenuationAboveWaters) {
+  fct::Volume ct = fourVoxelCt();
+  ct.voxels() = {-500.0f, 100.0f, 500.0f, 1100.0f};
+  fct::DrrValueOptions options;
+  options.boneContrast = 1.8;
+  const auto volume = fct::DrrVolume::create(ct, options);
+  ASSERT_TRUE(volume.ok()) << volume.error();
+  const double mu = fct::DrrValueOptions::kWaterAttenuationAt60keV_per_mm;
+  const std::vector<float>& v = volume.value().values().voxels();
+  EXPECT_NEAR(v[0], 0.5 * mu, 1e-7);  // water-like tissue scales with water, up to 100 HU
+  EXPECT_NEAR(v[1], 1.1 * mu, 1e-7);
+  EXPECT_NEAR(v[2], (1.1 + 1.8 * 0.4) * mu, 1e-7);  // water-bone mixtures: what they add above 100 HU times 1.8
+  EXPECT_NEAR(v[3], (1.1 + 1.8) * mu, 1e-7);
+  EXPECT_EQ(volume.value().options().boneContrast, 1.8);
+}
+
 TEST(DrrVolume, RawValuesAndGeometryAreThoseOfTheCt) {
   const fct::Volume ct = fourVoxelCt();
   fct::DrrValueOptions options;
@@ -63,7 +79,7 @@ TEST(DrrVolume, ContentBoxHoldsExactlyTheNonZeroVoxels) {
   EXPECT_FALSE(fct::DrrVolume::create(ct).value().hasContent());
 }
 
-TEST(DrrVolume, RejectsEmptyCtNonFiniteVoxelsAndBadWaterAttenuation) {
+TEST(DrrVolume, RejectsEmptyCtNonFiniteVoxelsBadWaterAttenuationAndBadBoneContrast) {
   EXPECT_FALSE(fct::DrrVolume::create(fct::Volume()).ok());
   fct::Volume ct = fourVoxelCt();
   ct.voxels()[2] = std::numeric_limits<float>::quiet_NaN();
@@ -73,6 +89,13 @@ TEST(DrrVolume, RejectsEmptyCtNonFiniteVoxelsAndBadWaterAttenuation) {
   fct::DrrValueOptions options;
   options.waterAttenuation_per_mm = 0.0;
   EXPECT_FALSE(fct::DrrVolume::create(fourVoxelCt(), options).ok());
+  for (const double contrast : {0.0, -1.0, 10.5, std::numeric_limits<double>::quiet_NaN()}) {
+    fct::DrrValueOptions bad;
+    bad.boneContrast = contrast;
+    const auto refused = fct::DrrVolume::create(fourVoxelCt(), bad);
+    ASSERT_FALSE(refused.ok()) << contrast;
+    EXPECT_NE(refused.error().find("bone contrast must be above 0 and at most 10"), std::string::npos) << refused.error();
+  }
 }
 
 TEST(DrrVolume, CoarsenedAveragesBlocksWithAirBeyondTheEdgeAndKeepsTheFrame) {
