@@ -393,8 +393,10 @@ bool RegisterStepWidget::run() {
 
   const auto ablations = options.ablation.activeNames();
   appendLog(QString::fromStdString(fmt::format(
-      "Run: preset {}, seed {}, DRR {}, ROIs {} px keeping {:.1f} %, switched off: {}; initial pose: {}",
-      options.schedule.name, options.seed, studioOptions.drrMethod, roi.windowSize, 100.0 * roi.targetFraction,
+      "Run: preset {}, seed {}, DRR {} (bone contrast {:g}), ROIs {} px keeping {:.1f} %, switched off: {}; initial "
+      "pose: {}",
+      options.schedule.name, options.seed, studioOptions.drrMethod, studioOptions.boneContrast, roi.windowSize,
+      100.0 * roi.targetFraction,
       ablations.empty() ? std::string("none") : fmt::format("{}", fmt::join(ablations, ", ")),
       m_document->initialPoseSource().toStdString())));
 

@@ -20,9 +20,9 @@
 
 class QCheckBox;
 class QComboBox;
+class QDoubleSpinBox;
 class QLabel;
 class QPlainTextEdit;
-class QDoubleSpinBox;
 class QProgressBar;
 class QPushButton;
 class QSpinBox;
