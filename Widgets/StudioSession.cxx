@@ -297,7 +297,7 @@ Status readRegistrationSection(const nlohmann::json& section, const SessionFile&
   r.drrMethod = registration.string("drr_method");
   // A session written before the key existed keeps the default.
   if (registration.has("bone_contrast")) r.boneContrast = registration.number("bone_contrast");
-  if (registration.ok() && !(r.boneContrast > 0.0 && r.boneContrast <= DrrValueOptions::kMaxBoneContrast)) {
+  if (registration.ok() && !DrrValueOptions::acceptsBoneContrast(r.boneContrast)) {
     registration.rejectKey("bone_contrast",
                            fmt::format("must be above 0 and at most {:g}", DrrValueOptions::kMaxBoneContrast));
   }

@@ -83,7 +83,7 @@ void addBoneContrastOption(CLI::App& command, double& contrast) {
                   "the X-ray's beam sees of bone than the CT's did. The default suits an 80 kVp fluoroscope and a "
                   "120 kVp CT, about 1.3 a 100 kVp one; 1 = the CT's own contrast (docs/registration.md, \"Bone "
                   "contrast\")")
-      ->check(finiteNumber([](double value) { return value > 0.0 && value <= DrrValueOptions::kMaxBoneContrast; },
+      ->check(finiteNumber(DrrValueOptions::acceptsBoneContrast,
                            fmt::format("a number above 0 and up to {:g}", DrrValueOptions::kMaxBoneContrast),
                            "FACTOR"))
       ->capture_default_str();

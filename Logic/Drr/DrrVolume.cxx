@@ -22,7 +22,7 @@ Result<DrrVolume> DrrVolume::prepare(const Volume& ct, const DrrValueOptions& op
     return fail(fmt::format("water attenuation must be positive and finite, got {} /mm", options.waterAttenuation_per_mm));
   }
   if (options.kind == DrrValueKind::Attenuation &&
-      !(options.boneContrast > 0.0 && options.boneContrast <= DrrValueOptions::kMaxBoneContrast)) {  // also NaN
+      !DrrValueOptions::acceptsBoneContrast(options.boneContrast)) {
     return fail(fmt::format("bone contrast must be above 0 and at most {:g}, got {}", DrrValueOptions::kMaxBoneContrast,
                             options.boneContrast));
   }

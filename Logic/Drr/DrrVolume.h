@@ -35,6 +35,8 @@ struct DrrValueOptions {
   static constexpr double kMaxBoneContrast = 10.0;
   /// CT values above this are water-bone mixtures; soft tissues (about -100 to +100 HU) and fat are water-like.
   static constexpr double kBoneFrom_hu = 100.0;
+  /// Whether `contrast` is an accepted bone contrast: above 0 and at most kMaxBoneContrast (NaN is not).
+  static constexpr bool acceptsBoneContrast(double contrast) { return contrast > 0.0 && contrast <= kMaxBoneContrast; }
 
   DrrValueKind kind = DrrValueKind::Attenuation;
   double waterAttenuation_per_mm = kWaterAttenuationAt60keV_per_mm;  ///< µ_water used by Attenuation
