@@ -1,10 +1,11 @@
 // The metal mask on physically simulated views (continuous patient, 80 kVp, 10,000 photons per pixel, PSF 0.7 px;
 // the 5 standard obliquities AP, lateral, oblique 45/30/60 on a 192x144 detector of 1.6 mm pixels) of the built-in
 // phantom and, when ../shared/data is there, of the head phantom and pelvis CTs: once reviewed against a DRR near the
-// truth (MetalMaskReview, as registration does after its first stage), it removes less than 0.5 % of each metal-free
-// view's pixels whose rays the CT covers (CutFaceRayMask, 5 mm: elsewhere the X-ray shows anatomy the CT lacks and the
-// review cannot judge a piece), and the detector covers most of the pixels of K-wires and screws that are not in the
-// CT (the pixels whose line integral the tools raise by more than 0.5 over the metal-free view with the same noise).
+// truth (MetalMaskReview, as registration does after its first stage, the DRR with the case's default bone contrast),
+// it removes less than 0.5 % of each metal-free view's pixels whose rays the CT covers (CutFaceRayMask, 5 mm: elsewhere
+// the X-ray shows anatomy the CT lacks and the review cannot judge a piece), and the detector covers most of the pixels
+// of K-wires and screws that are not in the CT (the pixels whose line integral the tools raise by more than 0.5 over
+// the metal-free view with the same noise).
 // The detector's own fraction and the reviewed fraction of the whole view are printed beside it. The per-view table of
 // docs/evaluation.md comes from the disabled MetalMaskStudy test (both CTs, also at 0.8 mm pixels; about 5 min). The
 // real shoulder fluoroscopy's K-wire stays disabled: the contrast-processed image's wire stands only ~0.5 above its
@@ -27,6 +28,7 @@
 #include "Evaluation/StudyRunner.h"
 #include "IO/Volume/CtLoader.h"
 #include "Image/BoneSurface.h"
+#include "Registration/RegistrationCase.h"
 #include "Simulation/FluoroscopySimulator.h"
 #include "Simulation/PhantomBuilder.h"
 #include "Simulation/StandardViews.h"
@@ -101,7 +103,10 @@ std::vector<ViewMeasure> measureViews(const fct::Volume& ct, const std::string& 
   const std::vector<fct::FloatImage> toolImages = coverage ? renderViews(ct, cameras, T_truth, true) : freeImages;
   if (freeImages.size() != views.size() || toolImages.size() != views.size()) return {};
   const fct::MetalMaskDetector detector;
-  const auto drrVolume = std::make_shared<const fct::DrrVolume>(fct::DrrVolume::create(ct).value());
+  // The review's DRR as registration renders it: with the case's default bone contrast.
+  fct::DrrValueOptions drrValues;
+  drrValues.boneContrast = fct::RegistrationCaseOptions::kDefaultBoneContrast;
+  const auto drrVolume = std::make_shared<const fct::DrrVolume>(fct::DrrVolume::create(ct, drrValues).value());
   const fct::SiddonRayCaster drrRenderer(drrVolume);
   const auto cutFaces = fct::CutFaceRayMask::create(*drrVolume, 5.0);
   EXPECT_TRUE(cutFaces.ok()) << cutFaces.error();
